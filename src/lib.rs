@@ -1,0 +1,25 @@
+//! # eij — acceleration correlated position errors of machine tools
+//!
+//! eij calibrates a multi-body (MB) model of a machine tool from R-Test circle measurements so that
+//! the model predicts the acceleration correlated position errors `EIJ` at the tool centre point
+//! (deviation in direction I per set acceleration of axis J, µm·s²/m).
+//!
+//! The module tree follows the data path:
+//!
+//! ```text
+//! machine ─► mbs ─► control ─► sim ─► rtest ─► ident ─► report
+//! ```
+//!
+//! * [`machine`]: the validated machine description (bodies, axes, guideways, drives, control),
+//!   read from TOML with catalogue look-up of carriage stiffness.
+//! * [`mbs`]: assembly of the mass, damping and stiffness matrices at an axis position; modal
+//!   analysis.
+//! * [`control`]: drives under cascaded P-PI control; the closed loop in state space.
+//! * [`sim`]: set points (circle, jerk-limited move) and exact time-domain discretisation.
+//! * [`rtest`]: reading and evaluating R-Test circle tests into EIJ with standard errors.
+//!
+//! Equation numbers (eq. 3–6, section 2.2/2.3) refer to the paper on acceleration correlated
+//! position errors measured with the R-Test that this tool implements and extends.
+
+pub mod io;
+pub mod rtest;
