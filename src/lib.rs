@@ -21,5 +21,6 @@
 //! Equation numbers (eq. 3–6, section 2.2/2.3) refer to the paper on acceleration correlated
 //! position errors measured with the R-Test that this tool implements and extends.
 
+pub mod axes;
 pub mod io;
 pub mod rtest;
