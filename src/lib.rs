@@ -22,5 +22,9 @@
 //! position errors measured with the R-Test that this tool implements and extends.
 
 pub mod axes;
+pub mod control;
 pub mod io;
+pub mod machine;
+pub mod mbs;
 pub mod rtest;
+pub mod sim;

@@ -1,0 +1,60 @@
+//! Options shared by the commands that load a machine.
+
+use anyhow::Context;
+use eij::machine::Machine;
+use std::path::PathBuf;
+
+/// `--machine FILE.toml [--position-mm X,Y,Z]`.
+#[derive(Debug, clap::Args)]
+pub struct MachineArgs {
+    /// Machine description (TOML).
+    #[arg(long, value_name = "FILE.toml")]
+    pub machine: PathBuf,
+    /// Axis positions at which the model is assembled, mm, comma separated in the machine's axis
+    /// order (default: the reference positions of the machine file).
+    #[arg(
+        long,
+        value_name = "X,Y,Z",
+        value_delimiter = ',',
+        allow_hyphen_values = true
+    )]
+    pub position_mm: Option<Vec<f64>>,
+}
+
+impl MachineArgs {
+    /// Loads the machine and the pose (m).
+    pub fn load(&self) -> anyhow::Result<(Machine, Vec<f64>)> {
+        let machine = Machine::from_file(&self.machine)?;
+        let pose = match &self.position_mm {
+            None => machine.reference_pose(),
+            Some(p) => {
+                if p.len() != machine.axes.len() {
+                    anyhow::bail!(
+                        "--position-mm: {} values given, machine {} has {} axes ({})",
+                        p.len(),
+                        self.machine.display(),
+                        machine.axes.len(),
+                        machine
+                            .axes
+                            .iter()
+                            .map(|a| a.axis.name())
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    );
+                }
+                p.iter().map(|v| v * 1e-3).collect()
+            }
+        };
+        Ok((machine, pose))
+    }
+}
+
+/// Writes `bytes` atomically to `out`, refusing to overwrite the machine file.
+pub fn write_output(
+    out: &std::path::Path,
+    bytes: &[u8],
+    inputs: &[&std::path::Path],
+) -> anyhow::Result<()> {
+    eij::io::write_atomic(out, bytes, inputs).with_context(|| "output not written")?;
+    Ok(())
+}

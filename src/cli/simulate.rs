@@ -1,0 +1,171 @@
+//! `eij simulate circle|move …`: closed-loop time-domain simulation to an R-Test-like CSV.
+
+use super::machine_args::{write_output, MachineArgs};
+use anyhow::bail;
+use eij::axes::{Axis, Direction, Plane};
+use eij::control::ClosedLoop;
+use eij::sim::setpoint::{Circle, JerkLimitedMove, SetPoint};
+use eij::sim::{output, simulate};
+use std::path::PathBuf;
+
+/// Arguments of `eij simulate`.
+#[derive(Debug, clap::Args)]
+pub struct SimulateArgs {
+    #[command(subcommand)]
+    test: Test,
+}
+
+#[derive(Debug, clap::Subcommand)]
+enum Test {
+    /// A circle test (paper eq. 3–4) with smooth ramps.
+    Circle(CircleArgs),
+    /// A jerk-limited positioning move of one axis.
+    Move(MoveArgs),
+}
+
+/// Options of every simulation.
+#[derive(Debug, clap::Args)]
+struct Common {
+    #[command(flatten)]
+    machine: MachineArgs,
+    /// Output CSV file (CONTRACT.md columns).
+    #[arg(long, value_name = "FILE.csv")]
+    out: PathBuf,
+    /// Output sample rate, Hz.
+    #[arg(long, default_value_t = 10_000.0)]
+    rate_hz: f64,
+}
+
+#[derive(Debug, clap::Args)]
+struct CircleArgs {
+    #[command(flatten)]
+    common: Common,
+    /// Plane: xy, yz or zx.
+    #[arg(long)]
+    plane: Plane,
+    /// Circle radius, mm (the R-Test range is ±3 mm).
+    #[arg(long, allow_hyphen_values = true)]
+    radius_mm: f64,
+    /// Steady set acceleration r·ω², m/s².
+    #[arg(long, allow_hyphen_values = true)]
+    accel_m_s2: f64,
+    /// cw or ccw.
+    #[arg(long)]
+    direction: Direction,
+    /// Number of whole steady revolutions.
+    #[arg(long, default_value_t = 5)]
+    revolutions: u32,
+}
+
+#[derive(Debug, clap::Args)]
+struct MoveArgs {
+    #[command(flatten)]
+    common: Common,
+    /// The moving axis: x, y or z.
+    #[arg(long)]
+    axis: Axis,
+    /// Signed distance, mm.
+    #[arg(long, allow_hyphen_values = true)]
+    distance_mm: f64,
+    /// Feed (velocity limit), mm/min.
+    #[arg(long, allow_hyphen_values = true)]
+    feed_mm_min: f64,
+    /// Acceleration limit, m/s².
+    #[arg(long, allow_hyphen_values = true)]
+    accel_m_s2: f64,
+    /// Jerk limit, m/s³.
+    #[arg(long, allow_hyphen_values = true)]
+    jerk_m_s3: f64,
+}
+
+fn positive(name: &str, v: f64) -> anyhow::Result<f64> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        bail!("--{name}: {v} must be a positive number")
+    }
+}
+
+/// Runs `eij simulate`.
+pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
+    match args.test {
+        Test::Circle(c) => {
+            let radius_mm = positive("radius-mm", c.radius_mm)?;
+            if radius_mm > 3.0 {
+                bail!("--radius-mm: {radius_mm} mm exceeds the R-Test probe range of ±3 mm");
+            }
+            let accel = positive("accel-m-s2", c.accel_m_s2)?;
+            if c.revolutions == 0 {
+                bail!("--revolutions: at least one steady revolution is needed");
+            }
+            let mut circle = Circle::new(c.plane, radius_mm * 1e-3, accel, c.direction);
+            circle.steady_revolutions = c.revolutions;
+            run_setpoint(&c.common, &circle, Some(c.plane))
+        }
+        Test::Move(m) => {
+            if !(m.distance_mm.is_finite() && m.distance_mm != 0.0) {
+                bail!("--distance-mm: {} must be a non-zero number", m.distance_mm);
+            }
+            let v = positive("feed-mm-min", m.feed_mm_min)? / 60_000.0;
+            let a = positive("accel-m-s2", m.accel_m_s2)?;
+            let j = positive("jerk-m-s3", m.jerk_m_s3)?;
+            let mv = JerkLimitedMove::new(m.axis, m.distance_mm * 1e-3, v, a, j);
+            eprintln!(
+                "move {}: {:.3} mm, peak velocity {:.4} m/s, peak set acceleration {:.3} m/s², {:.4} s",
+                m.axis,
+                m.distance_mm,
+                mv.peak_velocity_m_s,
+                mv.peak_accel_m_s2,
+                mv.motion_s()
+            );
+            run_move(&m.common, &mv)
+        }
+    }
+}
+
+fn run_move(common: &Common, mv: &JerkLimitedMove) -> anyhow::Result<()> {
+    let (machine, pose) = common.machine.load()?;
+    let Some(i) = machine.axes.iter().position(|a| a.axis == mv.axis) else {
+        bail!("{}: the machine has no axis {}", machine.source, mv.axis);
+    };
+    let [lo, hi] = machine.axes[i].stroke_m;
+    let end = pose[i] + mv.distance_m;
+    if end < lo || end > hi {
+        bail!(
+            "--distance-mm: the move ends at {:.1} mm, outside the {} stroke [{:.1}, {:.1}] mm",
+            end * 1e3,
+            mv.axis,
+            lo * 1e3,
+            hi * 1e3
+        );
+    }
+    // One assembly at the middle of the move (see README: position dependence).
+    let mut mid = pose.clone();
+    mid[i] += mv.distance_m / 2.0;
+    let cl = ClosedLoop::new(&machine, &mid)?;
+    write_run(common, &cl, mv)
+}
+
+fn run_setpoint(common: &Common, sp: &dyn SetPoint, plane: Option<Plane>) -> anyhow::Result<()> {
+    let (machine, pose) = common.machine.load()?;
+    if let Some(p) = plane {
+        let (a, b) = p.axes();
+        for ax in [a, b] {
+            if machine.axis(ax).is_none() {
+                bail!(
+                    "{}: the machine has no axis {ax}, cannot run a circle in plane {p}",
+                    machine.source
+                );
+            }
+        }
+    }
+    let cl = ClosedLoop::new(&machine, &pose)?;
+    write_run(common, &cl, sp)
+}
+
+fn write_run(common: &Common, cl: &ClosedLoop, sp: &dyn SetPoint) -> anyhow::Result<()> {
+    let rate = positive("rate-hz", common.rate_hz)?;
+    let run = simulate(cl, sp, rate)?;
+    let bytes = output::to_csv(cl, &run);
+    write_output(&common.out, &bytes, &[&common.machine.machine])
+}

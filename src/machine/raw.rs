@@ -1,0 +1,278 @@
+//! The machine file as written: serde structures, unknown keys rejected. Validation into
+//! [`super::Machine`] happens once, in [`super::Machine::from_raw`].
+
+use serde::{Deserialize, Serialize};
+
+fn one() -> f64 {
+    1.0
+}
+fn is_one(x: &f64) -> bool {
+    *x == 1.0
+}
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
+fn steel_modulus() -> f64 {
+    2.1e11
+}
+
+/// A whole machine file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawMachine {
+    /// Short machine name.
+    pub name: String,
+    /// Free text.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub description: String,
+    /// Extra carriage catalogues (TOML, same layout as `machines/catalogue/carriages.toml`),
+    /// relative to the machine file; the bundled catalogue is always available.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub catalogue: Vec<String>,
+    /// Stiffness-proportional (Rayleigh) damping D += β·K, in s.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub rayleigh_beta_s: f64,
+    /// Where the file came from (written by `eij identify`); free-form.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub provenance: Option<toml::Table>,
+    /// Tool centre point: a point of the tool-side body.
+    pub tcp: RawBodyPoint,
+    /// Workpiece point (R-Test nest): a point of the workpiece-side body.
+    pub workpiece: RawBodyPoint,
+    /// Rigid bodies.
+    #[serde(rename = "body")]
+    pub bodies: Vec<RawBody>,
+    /// Linear axes.
+    #[serde(rename = "axis", default)]
+    pub axes: Vec<RawAxis>,
+    /// Compliant joints (levelling feet, bolted joints).
+    #[serde(rename = "joint", default, skip_serializing_if = "Vec::is_empty")]
+    pub joints: Vec<RawJoint>,
+}
+
+/// A point fixed to a named body, machine coordinates at the reference position, m.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawBodyPoint {
+    /// Body name.
+    pub body: String,
+    /// Point, m.
+    pub point_m: [f64; 3],
+}
+
+/// A rigid body.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawBody {
+    /// Unique name.
+    pub name: String,
+    /// Fixed to the ground (no degrees of freedom).
+    #[serde(default)]
+    pub fixed: bool,
+    /// Mass, kg (free bodies).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mass_kg: Option<f64>,
+    /// Centre of gravity, m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cog_m: Option<[f64; 3]>,
+    /// Inertia tensor about the centre of gravity in machine axes, kg·m².
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inertia_kg_m2: Option<[[f64; 3]; 3]>,
+}
+
+/// A linear axis: the moving body runs on guideways of the carrier body, driven by a ball screw.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawAxis {
+    /// `x`, `y` or `z`.
+    pub name: String,
+    /// Body carrying the rails (and the motor and screw bearing).
+    pub carrier: String,
+    /// Body carrying the carriages and the nut.
+    pub moving: String,
+    /// Axis range [min, max], m, in axis coordinates (ISO 841).
+    pub stroke_m: [f64; 2],
+    /// Axis position at which the points of this file are given, m.
+    #[serde(default)]
+    pub reference_m: f64,
+    /// Guideway.
+    pub guideway: RawGuideway,
+    /// Ball-screw drive.
+    pub drive: RawDrive,
+    /// Cascaded P-PI controller.
+    pub control: RawControl,
+}
+
+/// Guideway of an axis.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawGuideway {
+    /// Catalogue id of the carriage, e.g. `HIWIN HGH25CA ZA`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub carriage: Option<String>,
+    /// Normal stiffness per carriage, N/µm, instead of a catalogue entry.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stiffness_normal_n_per_um: Option<f64>,
+    /// Lateral stiffness per carriage, N/µm, instead of a catalogue entry.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stiffness_lateral_n_per_um: Option<f64>,
+    /// Reduction factor on the normal stiffness.
+    #[serde(default = "one", skip_serializing_if = "is_one")]
+    pub reduction_normal: f64,
+    /// Reduction factor on the lateral stiffness.
+    #[serde(default = "one", skip_serializing_if = "is_one")]
+    pub reduction_lateral: f64,
+    /// Viscous damping per carriage in the normal direction, N·s/m.
+    #[serde(default)]
+    pub damping_normal_n_s_per_m: f64,
+    /// Viscous damping per carriage in the lateral direction, N·s/m.
+    #[serde(default)]
+    pub damping_lateral_n_s_per_m: f64,
+    /// Rails.
+    #[serde(rename = "rail")]
+    pub rails: Vec<RawRail>,
+}
+
+/// One rail and the carriages running on it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawRail {
+    /// Normal (radial load) direction of the carriages, from rail to carriage.
+    pub normal: [f64; 3],
+    /// Carriage points on the moving body, m, at the reference position.
+    pub carriages_m: Vec<[f64; 3]>,
+}
+
+/// Screw support arrangement.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Support {
+    /// Fixed bearing at `bearing_m`, free (or floating) far end: shaft stiffness E·A/L.
+    FixedFree,
+    /// Fixed bearings at both ends: E·A·L/(l₁·(L − l₁)).
+    FixedFixed,
+}
+
+/// Ball-screw drive of an axis.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawDrive {
+    /// Nut point on the moving body (line of the drive force), m, at the reference position.
+    pub nut_m: [f64; 3],
+    /// Fixed bearing of the screw on the carrier, m.
+    pub bearing_m: [f64; 3],
+    /// Reading head of the linear scale on the moving body, m, at the reference position.
+    pub scale_m: [f64; 3],
+    /// Screw lead, m per revolution.
+    pub lead_m: f64,
+    /// Screw root diameter, m.
+    pub screw_diameter_m: f64,
+    /// Young's modulus of the screw, Pa.
+    #[serde(default = "steel_modulus")]
+    pub screw_modulus_pa: f64,
+    /// Bearing arrangement.
+    pub support: Support,
+    /// Distance between the two fixed bearings (fixed-fixed only), m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub screw_length_m: Option<f64>,
+    /// Axial stiffness of the nut, N/µm.
+    pub nut_stiffness_n_per_um: f64,
+    /// Axial stiffness of the support bearing(s), N/µm.
+    pub bearing_stiffness_n_per_um: f64,
+    /// Reduction factor on the total axial stiffness.
+    #[serde(default = "one", skip_serializing_if = "is_one")]
+    pub reduction: f64,
+    /// Axial damping of the screw, N·s/m.
+    #[serde(default)]
+    pub damping_n_s_per_m: f64,
+    /// Rotor inertia of motor + coupling + screw, kg·m².
+    pub rotor_inertia_kg_m2: f64,
+    /// Viscous friction on the rotor, N·m·s/rad.
+    #[serde(default)]
+    pub friction_nm_s_per_rad: f64,
+}
+
+/// Feedback of the position loop.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Feedback {
+    /// Linear scale (direct measuring system).
+    Scale,
+    /// Motor encoder through the screw lead (indirect).
+    Encoder,
+}
+
+fn scale() -> Feedback {
+    Feedback::Scale
+}
+
+/// Cascaded P-PI controller of an axis.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawControl {
+    /// Position-loop gain Kv, 1/s.
+    pub kv_per_s: f64,
+    /// Velocity-loop proportional gain Kp, N·m·s/rad (motor side).
+    pub kp_nm_s_per_rad: f64,
+    /// Velocity-loop integral time Tn, s.
+    pub tn_s: f64,
+    /// Current-loop time constant, s (0 = ideal current loop).
+    #[serde(default)]
+    pub current_lag_s: f64,
+    /// Position feedback.
+    #[serde(default = "scale")]
+    pub feedback: Feedback,
+    /// Velocity feed-forward gain (0…1).
+    #[serde(default = "one")]
+    pub velocity_feedforward: f64,
+    /// Acceleration (torque) feed-forward gain (0…1).
+    #[serde(default = "one")]
+    pub acceleration_feedforward: f64,
+}
+
+/// A compliant joint between two bodies at a point (translational springs in machine axes).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawJoint {
+    /// Name.
+    pub name: String,
+    /// First body.
+    pub body: String,
+    /// Second body (often a fixed one, e.g. the floor).
+    pub other: String,
+    /// Joint point, m.
+    pub point_m: [f64; 3],
+    /// Stiffness along x, y, z, N/m.
+    pub stiffness_n_per_m: [f64; 3],
+    /// Damping along x, y, z, N·s/m.
+    #[serde(default)]
+    pub damping_n_s_per_m: [f64; 3],
+}
+
+/// A carriage catalogue file.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawCatalogue {
+    /// Entries.
+    #[serde(rename = "carriage")]
+    pub carriages: Vec<RawCarriage>,
+}
+
+/// A catalogue entry.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawCarriage {
+    /// Id used in machine files.
+    pub id: String,
+    /// Compressive (radial) stiffness, N/µm.
+    pub radial_n_per_um: f64,
+    /// Tensile (reverse-radial) stiffness, N/µm.
+    pub reverse_radial_n_per_um: f64,
+    /// Lateral stiffness, N/µm.
+    pub lateral_n_per_um: f64,
+    /// Which values are estimates.
+    #[serde(default)]
+    pub estimated: Vec<String>,
+    /// Published source.
+    pub source: String,
+}

@@ -1,0 +1,169 @@
+//! Time-domain simulation of the closed loop: exact discretisation with a first-order hold on
+//! the set points, and the R-Test-like output series of CONTRACT.md.
+//!
+//! Over one output step h, with the set points linear between samples
+//! (u(t) = u_k + (t − t_k)/h·(u_{k+1} − u_k)), the exact solution of ẋ = A x + B u is
+//! x_{k+1} = Φ x_k + Γ₀ u_k + Γ₁ u_{k+1}, read off one matrix exponential:
+//!
+//! ```text
+//! exp([[A h, B h, 0], [0, 0, I], [0, 0, 0]]) = [[Φ, Γa, Γb], [0, I, I], [0, 0, I]],
+//! Γ₀ = Γa − Γb,  Γ₁ = Γb.
+//! ```
+
+pub mod output;
+pub mod setpoint;
+
+use crate::control::ClosedLoop;
+use nalgebra::{DMatrix, DVector};
+use setpoint::SetPoint;
+
+/// The discretised closed loop at one step size.
+#[derive(Debug, Clone)]
+pub struct Discrete {
+    /// Output step, s.
+    pub step_s: f64,
+    /// Φ = exp(A h).
+    pub phi: DMatrix<f64>,
+    /// Γ₀ (weight of u_k).
+    pub gamma0: DMatrix<f64>,
+    /// Γ₁ (weight of u_{k+1}).
+    pub gamma1: DMatrix<f64>,
+}
+
+impl Discrete {
+    /// Exact first-order-hold discretisation of `cl` at step `step_s`.
+    pub fn new(cl: &ClosedLoop, step_s: f64) -> Discrete {
+        let nx = cl.a.nrows();
+        let nu = cl.b.ncols();
+        let n = nx + 2 * nu;
+        let mut m = DMatrix::zeros(n, n);
+        m.view_mut((0, 0), (nx, nx)).copy_from(&(&cl.a * step_s));
+        m.view_mut((0, nx), (nx, nu)).copy_from(&(&cl.b * step_s));
+        m.view_mut((nx, nx + nu), (nu, nu)).fill_with_identity();
+        let e = m.exp();
+        let phi = e.view((0, 0), (nx, nx)).into_owned();
+        let ga = e.view((0, nx), (nx, nu)).into_owned();
+        let gb = e.view((0, nx + nu), (nx, nu)).into_owned();
+        Discrete {
+            step_s,
+            phi,
+            gamma0: ga - &gb,
+            gamma1: gb,
+        }
+    }
+}
+
+/// A simulated run: set inputs and outputs sampled at the output rate, stored sample-major
+/// (`inputs[k·nu + i]`, `outputs[k·ny + i]`).
+#[derive(Debug, Clone)]
+pub struct Run {
+    /// Sample times, s.
+    pub t_s: Vec<f64>,
+    /// Number of inputs per sample.
+    pub nu: usize,
+    /// Number of outputs per sample.
+    pub ny: usize,
+    /// Inputs, in the closed loop's input order.
+    pub inputs: Vec<f64>,
+    /// Outputs, in the closed loop's output order.
+    pub outputs: Vec<f64>,
+}
+
+impl Run {
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.t_s.len()
+    }
+
+    /// Whether the run has no samples.
+    pub fn is_empty(&self) -> bool {
+        self.t_s.is_empty()
+    }
+
+    /// The series of output `i`.
+    pub fn output(&self, i: usize) -> impl Iterator<Item = f64> + '_ {
+        self.outputs.iter().skip(i).step_by(self.ny).copied()
+    }
+
+    /// The series of input `i`.
+    pub fn input(&self, i: usize) -> impl Iterator<Item = f64> + '_ {
+        self.inputs.iter().skip(i).step_by(self.nu).copied()
+    }
+
+    /// The series of one named output, if the closed loop has it.
+    pub fn output_series(&self, cl: &ClosedLoop, name: &str) -> Option<Vec<f64>> {
+        Some(self.output(cl.output(name)?).collect())
+    }
+
+    /// The series of one named input, if the closed loop has it.
+    pub fn input_series(&self, cl: &ClosedLoop, name: &str) -> Option<Vec<f64>> {
+        Some(self.input(cl.input(name)?).collect())
+    }
+}
+
+/// Errors of the simulation.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SimError {
+    /// A non-physical request.
+    #[error("{0}")]
+    Invalid(String),
+    /// No equilibrium at the first set point (singular A).
+    #[error("the closed loop has no equilibrium at the first set point")]
+    NoEquilibrium,
+}
+
+/// Simulates `setpoint` from rest in equilibrium at its first value, sampled at `rate_hz`.
+pub fn simulate(cl: &ClosedLoop, setpoint: &dyn SetPoint, rate_hz: f64) -> Result<Run, SimError> {
+    if !(rate_hz.is_finite() && rate_hz > 0.0) {
+        return Err(SimError::Invalid(format!(
+            "sample rate {rate_hz} Hz must be > 0"
+        )));
+    }
+    let h = 1.0 / rate_hz;
+    let disc = Discrete::new(cl, h);
+    simulate_discrete(cl, &disc, setpoint)
+}
+
+/// As [`simulate`] with a discretisation computed beforehand (reuse it across set points).
+pub fn simulate_discrete(
+    cl: &ClosedLoop,
+    disc: &Discrete,
+    setpoint: &dyn SetPoint,
+) -> Result<Run, SimError> {
+    let h = disc.step_s;
+    let steps = (setpoint.duration_s() / h).ceil() as usize;
+    let nu = cl.b.ncols();
+    let nx = cl.a.nrows();
+    let ny = cl.c.nrows();
+    let mut u_now = DVector::zeros(nu);
+    let mut u_next = DVector::zeros(nu);
+    setpoint.eval(0.0, &cl.axes, u_now.as_mut_slice());
+    let mut x = cl.equilibrium(&u_now).ok_or(SimError::NoEquilibrium)?;
+    let mut x_next = DVector::zeros(nx);
+    let mut run = Run {
+        t_s: Vec::with_capacity(steps + 1),
+        nu,
+        ny,
+        inputs: Vec::with_capacity((steps + 1) * nu),
+        outputs: Vec::with_capacity((steps + 1) * ny),
+    };
+    let mut y = DVector::zeros(ny);
+    for k in 0..=steps {
+        let t = k as f64 * h;
+        y.gemv(1.0, &cl.c, &x, 0.0);
+        y.gemv(1.0, &cl.d, &u_now, 1.0);
+        run.t_s.push(t);
+        run.inputs.extend_from_slice(u_now.as_slice());
+        run.outputs.extend_from_slice(y.as_slice());
+        if k == steps {
+            break;
+        }
+        setpoint.eval(t + h, &cl.axes, u_next.as_mut_slice());
+        x_next.gemv(1.0, &disc.phi, &x, 0.0);
+        x_next.gemv(1.0, &disc.gamma0, &u_now, 1.0);
+        x_next.gemv(1.0, &disc.gamma1, &u_next, 1.0);
+        std::mem::swap(&mut x, &mut x_next);
+        std::mem::swap(&mut u_now, &mut u_next);
+    }
+    Ok(run)
+}

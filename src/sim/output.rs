@@ -1,0 +1,92 @@
+//! The simulated R-Test series in the CSV layout of CONTRACT.md.
+//!
+//! Columns: `t_s`; `x_int_mm`, `y_int_mm`, `z_int_mm` (linear-scale readings relative to the
+//! circle centre or move start; 0 for an axis the machine lacks); `x_ext_mm`, `y_ext_mm`,
+//! `z_ext_mm` (TCP relative to the workpiece); then per machine axis `<a>_set_mm`,
+//! `<a>_vel_set_m_s`, `<a>_acc_set_m_s2` (set points exactly as fed to the model),
+//! `<a>_acc_act_m_s2` (second derivative of the scale reading), `<a>_following_error_um`,
+//! `<a>_torque_nm`.
+
+use super::Run;
+use crate::axes::Axis;
+use crate::control::ClosedLoop;
+
+/// Column names and, per column, where its values come from.
+enum Source {
+    Time,
+    Output(usize, f64),
+    Input(usize, f64),
+    Zero,
+}
+
+fn columns(cl: &ClosedLoop) -> Vec<(String, Source)> {
+    let mut cols = vec![("t_s".to_string(), Source::Time)];
+    let out = |name: &str, scale: f64| match cl.output(name) {
+        Some(i) => Source::Output(i, scale),
+        None => Source::Zero,
+    };
+    for a in Axis::ALL {
+        cols.push((format!("{a}_int_mm"), out(&format!("{a}_int_m"), 1e3)));
+    }
+    for a in Axis::ALL {
+        cols.push((format!("{a}_ext_mm"), out(&format!("{a}_tcp_m"), 1e3)));
+    }
+    for a in &cl.axes {
+        let inp = |name: &str, scale: f64| match cl.input(name) {
+            Some(i) => Source::Input(i, scale),
+            None => Source::Zero,
+        };
+        cols.push((format!("{a}_set_mm"), inp(&format!("{a}_pos_set_m"), 1e3)));
+        cols.push((
+            format!("{a}_vel_set_m_s"),
+            inp(&format!("{a}_vel_set_m_s"), 1.0),
+        ));
+        cols.push((
+            format!("{a}_acc_set_m_s2"),
+            inp(&format!("{a}_acc_set_m_s2"), 1.0),
+        ));
+        cols.push((
+            format!("{a}_acc_act_m_s2"),
+            out(&format!("{a}_acc_act_m_s2"), 1.0),
+        ));
+        cols.push((
+            format!("{a}_following_error_um"),
+            out(&format!("{a}_following_error_m"), 1e6),
+        ));
+        cols.push((
+            format!("{a}_torque_nm"),
+            out(&format!("{a}_torque_nm"), 1.0),
+        ));
+    }
+    cols
+}
+
+/// The run as CSV text (comma separated, one header line, fixed 10-decimal numbers so that
+/// output is byte-identical across runs).
+pub fn to_csv(cl: &ClosedLoop, run: &Run) -> Vec<u8> {
+    let cols = columns(cl);
+    let mut w = csv::Writer::from_writer(Vec::with_capacity(run.len() * cols.len() * 16));
+    // Writing to memory cannot fail.
+    let _ = w.write_record(cols.iter().map(|(n, _)| n.as_str()));
+    let mut record = Vec::with_capacity(cols.len());
+    for k in 0..run.len() {
+        record.clear();
+        for (_, src) in &cols {
+            let v = match src {
+                Source::Time => run.t_s[k],
+                Source::Output(i, s) => run.outputs[k * run.ny + i] * s,
+                Source::Input(i, s) => run.inputs[k * run.nu + i] * s,
+                Source::Zero => 0.0,
+            };
+            let text = format!("{v:.10}");
+            // A value that rounds to zero is written without a sign.
+            if text.starts_with('-') && text[1..].bytes().all(|c| c == b'0' || c == b'.') {
+                record.push(text[1..].to_string());
+            } else {
+                record.push(text);
+            }
+        }
+        let _ = w.write_record(&record);
+    }
+    w.into_inner().unwrap_or_default()
+}
