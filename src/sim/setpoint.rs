@@ -135,7 +135,7 @@ impl SetPoint for Circle {
 /// A jerk-limited point-to-point move of one axis (seven phases: jerk +, constant acceleration,
 /// jerk −, cruise, jerk −, constant deceleration, jerk +). Where the distance is too short for a
 /// limit, the profile degrades: the peak velocity drops first, then the peak acceleration
-/// (a_peak = (D²·j/4)^(1/3)·… see [`JerkLimitedMove::new`]).
+/// (down to a_peak = (D·j²/2)^(1/3), see [`JerkLimitedMove::new`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct JerkLimitedMove {
     /// The moving axis.
@@ -189,7 +189,11 @@ impl JerkLimitedMove {
         };
         let a_peak = a_max.min((v_peak * j_max).sqrt());
         let t_jerk = a_peak / j_max;
-        let t_accel = (v_peak / a_peak - t_jerk).max(0.0);
+        let t_accel = if a_peak < a_max {
+            0.0
+        } else {
+            (v_peak / a_peak - t_jerk).max(0.0)
+        };
         let t_cruise = if v_peak > 0.0 {
             ((d - ramp_distance(v_peak)) / v_peak).max(0.0)
         } else {
@@ -270,10 +274,11 @@ mod tests {
     #[test]
     fn paper_move_peaks_at_8_55_m_s2() {
         let m = JerkLimitedMove::new(Axis::Z, 0.02, 0.5, 10.0, 250.0);
-        // a_peak = (D²·j/4)^(1/3)·… = √(v·j), v = (0.02²·250/4)^(1/3)
+        // Neither limit is reached: v = (D²·j/4)^(1/3), a_peak = √(v·j) = (D·j²/2)^(1/3).
         let v = (0.02f64 * 0.02 * 250.0 / 4.0).cbrt();
         assert!((m.peak_velocity_m_s - v).abs() < 1e-12);
         assert!((m.peak_accel_m_s2 - (v * 250.0).sqrt()).abs() < 1e-12);
+        assert!((m.peak_accel_m_s2 - (0.02f64 * 250.0 * 250.0 / 2.0).cbrt()).abs() < 1e-12);
         assert!((m.peak_accel_m_s2 - 8.55).abs() < 0.005);
         assert_eq!(m.t_accel_s, 0.0);
         let (p, v_end, a_end) = m.state(m.lead_s + m.motion_s());
