@@ -3,15 +3,16 @@
 //! Per axis (DESIGN.md "Drives and control"):
 //!
 //! ```text
-//! v_cmd = Kv·(x_set − x_fb) + k_vff·v_set                      position loop P, m/s
+//! x_c, v_c, a_c = x_set, v_set, a_set, or their first-order smoothing (set-point filter T_f)
+//! v_cmd = Kv·(x_c − x_fb) + k_vff·v_c                          position loop P, m/s
 //! e_ω   = ρ·v_cmd − φ̇,  ρ = σ·2π/h                              speed error at the motor, rad/s
-//! T_set = Kp·(e_ω + ζ/Tn) + k_aff·J_eq·ρ·a_set,  ζ̇ = e_ω         velocity loop PI + torque feed-forward
+//! T_set = Kp·(e_ω + ζ/Tn) + k_aff·J_eq·ρ·a_c,  ζ̇ = e_ω           velocity loop PI + torque feed-forward
 //! Tc·Ṫ  = T_set − T   (Tc = 0: T = T_set)                        current loop
 //! M q̈ + D q̇ + K q = b_rotor·T                                    structure (mbs)
 //! ```
 //!
 //! x_fb is the linear-scale reading (or the motor encoder); J_eq = J_rotor + m_moved·(h/2π)².
-//! With the state x = (q, q̇, ζ, T_lagged) the closed loop at an axis position is LTI:
+//! With the state x = (q, q̇, ζ, T_lagged, x_filtered) the closed loop at an axis position is LTI:
 //! ẋ = A x + B u, y = C x + D u, with inputs u = (x_set, v_set, a_set) per axis and the outputs
 //! named in [`ClosedLoop::outputs`].
 
@@ -63,13 +64,15 @@ pub struct ClosedLoop {
     pub c: DMatrix<f64>,
     /// Feed-through matrix.
     pub d: DMatrix<f64>,
-    /// State names: `q:<dof>`, `v:<dof>`, `<axis>.pi_integral`, `<axis>.torque`.
+    /// State names: `q:<dof>`, `v:<dof>`, `<axis>.pi_integral`, `<axis>.torque`,
+    /// `<axis>.setpoint_filter`.
     pub states: Vec<String>,
     /// Input names: `<axis>_pos_set_m`, `<axis>_vel_set_m_s`, `<axis>_acc_set_m_s2` per axis.
     pub inputs: Vec<String>,
     /// Output names: `<axis>_int_m` (linear scale) per axis, `x_tcp_m`, `y_tcp_m`, `z_tcp_m`
     /// (TCP relative to the workpiece), then per axis `<axis>_acc_act_m_s2` (second derivative
-    /// of the scale reading), `<axis>_following_error_m`, `<axis>_torque_nm`.
+    /// of the scale reading), `<axis>_following_error_m` (commanded minus fed-back position),
+    /// `<axis>_torque_nm`.
     pub outputs: Vec<String>,
     /// The machine axes, in input order.
     pub axes: Vec<Axis>,
@@ -95,9 +98,42 @@ impl ClosedLoop {
         let lagged: Vec<usize> = (0..na)
             .filter(|&i| machine.axes[i].control.current_lag_s > 0.0)
             .collect();
-        let nx = 2 * n + na + lagged.len();
+        let filtered: Vec<usize> = (0..na)
+            .filter(|&i| machine.axes[i].control.setpoint_filter_s > 0.0)
+            .collect();
+        let nx = 2 * n + na + lagged.len() + filtered.len();
         let nu = INPUTS_PER_AXIS * na;
         let (iq, iv, iz, it) = (0, n, 2 * n, 2 * n + na);
+        let i_f = it + lagged.len();
+
+        // Commanded position, velocity and acceleration seen by the controller, as rows over
+        // (x, u): the set points themselves, or their first-order smoothing p_f with
+        // ṗ_f = (x_set − p_f)/T_f, v_c = ṗ_f, a_c = (v_set − ṗ_f)/T_f.
+        let mut cpx = DMatrix::zeros(na, nx);
+        let mut cpu = DMatrix::zeros(na, nu);
+        let mut cvx = DMatrix::zeros(na, nx);
+        let mut cvu = DMatrix::zeros(na, nu);
+        let mut cax = DMatrix::zeros(na, nx);
+        let mut cau = DMatrix::zeros(na, nu);
+        for i in 0..na {
+            let (up, uv, ua) = (3 * i, 3 * i + 1, 3 * i + 2);
+            match filtered.iter().position(|&f| f == i) {
+                None => {
+                    cpu[(i, up)] = 1.0;
+                    cvu[(i, uv)] = 1.0;
+                    cau[(i, ua)] = 1.0;
+                }
+                Some(k) => {
+                    let tf = machine.axes[i].control.setpoint_filter_s;
+                    cpx[(i, i_f + k)] = 1.0;
+                    cvx[(i, i_f + k)] = -1.0 / tf;
+                    cvu[(i, up)] = 1.0 / tf;
+                    cax[(i, i_f + k)] = 1.0 / (tf * tf);
+                    cau[(i, up)] = -1.0 / (tf * tf);
+                    cau[(i, uv)] = 1.0 / tf;
+                }
+            }
+        }
 
         // Torque command T_set = gx·x + gu·u per axis (rows).
         let mut gx = DMatrix::zeros(na, nx);
@@ -105,9 +141,9 @@ impl ClosedLoop {
         // Speed error e_ω = ex·x + eu·u per axis (rows): the PI integrator's derivative.
         let mut ex = DMatrix::zeros(na, nx);
         let mut eu = DMatrix::zeros(na, nu);
-        // Following error x_set − x_fb.
-        let mut fx = DMatrix::zeros(na, nx);
-        let mut fu = DMatrix::zeros(na, nu);
+        // Following error x_cmd − x_fb.
+        let mut fx = cpx.clone();
+        let fu = cpu.clone();
         for (i, a) in machine.axes.iter().enumerate() {
             let p = &model.axes[i];
             let c = &a.control;
@@ -116,22 +152,23 @@ impl ClosedLoop {
                 Feedback::Encoder => &p.encoder,
             };
             let rho = p.rad_per_m;
-            let (up, uv, ua) = (3 * i, 3 * i + 1, 3 * i + 2);
-            fx.view_mut((i, iq), (1, n)).copy_from(&(-fb.transpose()));
-            fu[(i, up)] = 1.0;
-            // e_ω = ρ·(Kv·(x_set − fb·q) + k_vff·v_set) − φ̇
-            ex.view_mut((i, iq), (1, n))
-                .copy_from(&(-fb.transpose() * (rho * c.kv_per_s)));
-            ex[(i, iv + p.rotor_dof)] = -1.0;
-            eu[(i, up)] = rho * c.kv_per_s;
-            eu[(i, uv)] = rho * c.velocity_feedforward;
-            // T_set = Kp·e_ω + Kp/Tn·ζ + k_aff·J_eq·ρ·a_set
-            let row = ex.row(i) * c.kp_nm_s_per_rad;
+            {
+                let mut f = fx.view_mut((i, iq), (1, n));
+                f -= fb.transpose();
+            }
+            // e_ω = ρ·(Kv·(x_cmd − x_fb) + k_vff·v_cmd) − φ̇
+            let row = fx.row(i) * (rho * c.kv_per_s) + cvx.row(i) * (rho * c.velocity_feedforward);
+            ex.row_mut(i).copy_from(&row);
+            ex[(i, iv + p.rotor_dof)] -= 1.0;
+            let row = fu.row(i) * (rho * c.kv_per_s) + cvu.row(i) * (rho * c.velocity_feedforward);
+            eu.row_mut(i).copy_from(&row);
+            // T_set = Kp·e_ω + Kp/Tn·ζ + k_aff·J_eq·ρ·a_cmd
+            let ff = c.acceleration_feedforward * p.inertia_eq_kg_m2 * rho;
+            let row = ex.row(i) * c.kp_nm_s_per_rad + cax.row(i) * ff;
             gx.row_mut(i).copy_from(&row);
             gx[(i, iz + i)] += c.kp_nm_s_per_rad / c.tn_s;
-            let row = eu.row(i) * c.kp_nm_s_per_rad;
+            let row = eu.row(i) * c.kp_nm_s_per_rad + cau.row(i) * ff;
             gu.row_mut(i).copy_from(&row);
-            gu[(i, ua)] = c.acceleration_feedforward * p.inertia_eq_kg_m2 * rho;
         }
         // Applied torque T = tx·x + tu·u (the lag state, or T_set itself).
         let mut tx = gx.clone();
@@ -176,6 +213,10 @@ impl ClosedLoop {
             a_mat[(it + k, it + k)] -= 1.0 / tc;
             let row = gu.row(i) / tc;
             b_mat.row_mut(it + k).copy_from(&row);
+        }
+        for (k, &i) in filtered.iter().enumerate() {
+            a_mat.row_mut(i_f + k).copy_from(&cvx.row(i));
+            b_mat.row_mut(i_f + k).copy_from(&cvu.row(i));
         }
 
         // Outputs.

@@ -193,6 +193,8 @@ pub struct Control {
     pub tn_s: f64,
     /// Current-loop lag, s (0 = ideal).
     pub current_lag_s: f64,
+    /// Set-point smoothing time constant, s (0 = none).
+    pub setpoint_filter_s: f64,
     /// Position feedback.
     pub feedback: Feedback,
     /// Velocity feed-forward gain.
@@ -793,6 +795,7 @@ fn validate_control(
         kp_nm_s_per_rad: positive(c.kp_nm_s_per_rad, key("kp_nm_s_per_rad"))?,
         tn_s: positive(c.tn_s, key("tn_s"))?,
         current_lag_s: non_negative(c.current_lag_s, key("current_lag_s"))?,
+        setpoint_filter_s: non_negative(c.setpoint_filter_s, key("setpoint_filter_s"))?,
         feedback: c.feedback,
         velocity_feedforward: non_negative(c.velocity_feedforward, key("velocity_feedforward"))?,
         acceleration_feedforward: non_negative(

@@ -219,6 +219,10 @@ pub struct RawControl {
     /// Current-loop time constant, s (0 = ideal current loop).
     #[serde(default)]
     pub current_lag_s: f64,
+    /// Time constant of the CNC's first-order position set-point smoothing, s (0 = none).
+    /// It acts on position, velocity and acceleration commands alike.
+    #[serde(default)]
+    pub setpoint_filter_s: f64,
     /// Position feedback.
     #[serde(default = "scale")]
     pub feedback: Feedback,

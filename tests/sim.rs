@@ -1,0 +1,113 @@
+//! Time-domain simulation of circles and moves on the demo machine.
+
+use eij::axes::{Axis, Direction, Plane};
+use eij::control::ClosedLoop;
+use eij::machine::Machine;
+use eij::sim::setpoint::{Circle, JerkLimitedMove};
+use eij::sim::{output, simulate};
+use std::path::Path;
+
+fn demo() -> (Machine, ClosedLoop) {
+    let m =
+        Machine::from_file(&Path::new(env!("CARGO_MANIFEST_DIR")).join("machines/demo-vmc.toml"))
+            .unwrap();
+    let cl = ClosedLoop::new(&m, &m.reference_pose()).unwrap();
+    (m, cl)
+}
+
+fn correlation(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len() as f64;
+    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
+    let cov: f64 = a.iter().zip(b).map(|(x, y)| (x - ma) * (y - mb)).sum();
+    let va: f64 = a.iter().map(|x| (x - ma).powi(2)).sum();
+    let vb: f64 = b.iter().map(|y| (y - mb).powi(2)).sum();
+    cov / (va * vb).sqrt()
+}
+
+#[test]
+fn paper_move_set_and_actual_acceleration_and_cross_talk() {
+    // 20 mm, 30 000 mm/min, 10 m/s², 250 m/s³ on Z: neither velocity nor acceleration limit is
+    // reached; the set acceleration peaks at (D·j²/2)^(1/3) = 8.5499 m/s².
+    let (_, cl) = demo();
+    let mv = JerkLimitedMove::new(Axis::Z, 0.02, 0.5, 10.0, 250.0);
+    let run = simulate(&cl, &mv, 10_000.0).unwrap();
+    let a_set = run.input_series(&cl, "z_acc_set_m_s2").unwrap();
+    let a_act = run.output_series(&cl, "z_acc_act_m_s2").unwrap();
+    let peak_set = a_set.iter().cloned().fold(f64::MIN, f64::max);
+    let peak_act = a_act.iter().cloned().fold(f64::MIN, f64::max);
+    let hand = (0.02f64 * 250.0 * 250.0 / 2.0).cbrt();
+    assert!(
+        (peak_set - hand).abs() < 1e-3,
+        "set peak {peak_set} vs {hand}"
+    );
+    // The CNC's set-point smoothing (4 ms) and the drive lower the actual peak.
+    assert!(
+        peak_act < peak_set && peak_act > 0.8 * peak_set,
+        "actual peak {peak_act}"
+    );
+    // The TCP deviation in X (external − internal) follows the Z acceleration.
+    let x_ext = run.output_series(&cl, "x_tcp_m").unwrap();
+    let x_int = run.output_series(&cl, "x_int_m").unwrap();
+    let dev: Vec<f64> = x_ext.iter().zip(&x_int).map(|(e, i)| e - i).collect();
+    let r = correlation(&dev, &a_act);
+    assert!(r.abs() > 0.99, "correlation {r}");
+    // The move arrives: 20 mm within 1 µm at the end of the settling time.
+    let z = run.output_series(&cl, "z_int_m").unwrap();
+    assert!((z.last().unwrap() - 0.02).abs() < 1e-6);
+}
+
+#[test]
+fn circle_starts_at_rest_on_the_set_point_and_runs_at_7_96_hz() {
+    let (_, cl) = demo();
+    let circle = Circle::new(Plane::Zx, 0.002, 5.0, Direction::Ccw);
+    assert!((circle.frequency_hz() - 7.957747).abs() < 1e-6);
+    let run = simulate(&cl, &circle, 10_000.0).unwrap();
+    let z = run.output_series(&cl, "z_int_m").unwrap();
+    let x = run.output_series(&cl, "x_int_m").unwrap();
+    let ze = run.output_series(&cl, "z_tcp_m").unwrap();
+    // Equilibrium at the first set point (z = r, x = 0): no static deviation in a model without
+    // gravity, so internal and external readings both equal the set point.
+    assert!((z[0] - 0.002).abs() < 1e-15 && x[0].abs() < 1e-15 && (ze[0] - 0.002).abs() < 1e-15);
+    // Zero crossings of x (x = r·sin θ) in the steady part: half a period apart.
+    let (t0, t1) = (0.3, 0.8);
+    let crossings: Vec<f64> = (1..run.len())
+        .filter(|&k| run.t_s[k] > t0 && run.t_s[k] < t1 && x[k - 1] < 0.0 && x[k] >= 0.0)
+        .map(|k| run.t_s[k - 1] + (run.t_s[k] - run.t_s[k - 1]) * (-x[k - 1]) / (x[k] - x[k - 1]))
+        .collect();
+    assert!(crossings.len() >= 3);
+    let period = (crossings.last().unwrap() - crossings[0]) / (crossings.len() - 1) as f64;
+    assert!(
+        (1.0 / period - 7.957747).abs() < 1e-4,
+        "frequency {}",
+        1.0 / period
+    );
+}
+
+#[test]
+fn csv_has_the_contract_columns_and_is_deterministic() {
+    let (_, cl) = demo();
+    let circle = Circle::new(Plane::Xy, 0.002, 2.0, Direction::Cw);
+    let a = output::to_csv(&cl, &simulate(&cl, &circle, 2_000.0).unwrap());
+    let b = output::to_csv(&cl, &simulate(&cl, &circle, 2_000.0).unwrap());
+    assert_eq!(a, b);
+    let text = String::from_utf8(a).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    for col in [
+        "t_s",
+        "x_int_mm",
+        "y_int_mm",
+        "z_int_mm",
+        "x_ext_mm",
+        "y_ext_mm",
+        "z_ext_mm",
+        "x_set_mm",
+        "x_vel_set_m_s",
+        "x_acc_set_m_s2",
+        "y_set_mm",
+        "z_acc_set_m_s2",
+        "z_acc_act_m_s2",
+    ] {
+        assert!(header.contains(&col), "missing column {col}");
+    }
+    assert!(!text.contains("-0.0000000000,"));
+}
