@@ -87,8 +87,8 @@ fn circle_starts_at_rest_on_the_set_point_and_runs_at_7_96_hz() {
 fn csv_has_the_contract_columns_and_is_deterministic() {
     let (_, cl) = demo();
     let circle = Circle::new(Plane::Xy, 0.002, 2.0, Direction::Cw);
-    let a = output::to_csv(&cl, &simulate(&cl, &circle, 2_000.0).unwrap());
-    let b = output::to_csv(&cl, &simulate(&cl, &circle, 2_000.0).unwrap());
+    let a = output::to_csv(&cl, &simulate(&cl, &circle, 2_000.0).unwrap(), &Default::default());
+    let b = output::to_csv(&cl, &simulate(&cl, &circle, 2_000.0).unwrap(), &Default::default());
     assert_eq!(a, b);
     let text = String::from_utf8(a).unwrap();
     let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();

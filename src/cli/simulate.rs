@@ -34,6 +34,19 @@ struct Common {
     /// Output sample rate, Hz.
     #[arg(long, default_value_t = 10_000.0)]
     rate_hz: f64,
+    /// Add Gaussian noise of this standard deviation to the external (R-Test) columns, µm,
+    /// to generate realistic test data (the R-Test's U(k=2) = 2.8 µm is σ = 1.4 µm).
+    #[arg(long, default_value_t = 0.0)]
+    noise_um: f64,
+    /// Seed of the noise.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Write only the columns an R-Test measurement has (t, internal, external).
+    #[arg(long)]
+    required_only: bool,
+    /// Decimals of every number in the CSV.
+    #[arg(long, default_value_t = 10)]
+    decimals: usize,
 }
 
 #[derive(Debug, clap::Args)]
@@ -165,7 +178,16 @@ fn run_setpoint(common: &Common, sp: &dyn SetPoint, plane: Option<Plane>) -> any
 
 fn write_run(common: &Common, cl: &ClosedLoop, sp: &dyn SetPoint) -> anyhow::Result<()> {
     let rate = positive("rate-hz", common.rate_hz)?;
+    if !(common.noise_um.is_finite() && common.noise_um >= 0.0) {
+        bail!("--noise-um: {} must be ≥ 0", common.noise_um);
+    }
     let run = simulate(cl, sp, rate)?;
-    let bytes = output::to_csv(cl, &run);
+    let opts = output::CsvOptions {
+        required_only: common.required_only,
+        decimals: common.decimals.min(15),
+        noise_um: common.noise_um,
+        seed: common.seed,
+    };
+    let bytes = output::to_csv(cl, &run, &opts);
     write_output(&common.out, &bytes, &[&common.machine.machine])
 }

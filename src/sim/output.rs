@@ -10,6 +10,32 @@
 use super::Run;
 use crate::axes::Axis;
 use crate::control::ClosedLoop;
+use rand::SeedableRng;
+use rand_distr::{Distribution, Normal};
+
+/// How to write a run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CsvOptions {
+    /// Only the columns an R-Test measurement has (`t_s`, `*_int_mm`, `*_ext_mm`).
+    pub required_only: bool,
+    /// Decimals of every number.
+    pub decimals: usize,
+    /// Gaussian noise added to each external (R-Test) coordinate, µm (0 = none).
+    pub noise_um: f64,
+    /// Seed of the noise generator (ChaCha8: the same seed gives the same file everywhere).
+    pub seed: u64,
+}
+
+impl Default for CsvOptions {
+    fn default() -> Self {
+        CsvOptions {
+            required_only: false,
+            decimals: 10,
+            noise_um: 0.0,
+            seed: 1,
+        }
+    }
+}
 
 /// Column names and, per column, where its values come from.
 enum Source {
@@ -19,7 +45,7 @@ enum Source {
     Zero,
 }
 
-fn columns(cl: &ClosedLoop) -> Vec<(String, Source)> {
+fn columns(cl: &ClosedLoop, required_only: bool) -> Vec<(String, Source)> {
     let mut cols = vec![("t_s".to_string(), Source::Time)];
     let out = |name: &str, scale: f64| match cl.output(name) {
         Some(i) => Source::Output(i, scale),
@@ -30,6 +56,9 @@ fn columns(cl: &ClosedLoop) -> Vec<(String, Source)> {
     }
     for a in Axis::ALL {
         cols.push((format!("{a}_ext_mm"), out(&format!("{a}_tcp_m"), 1e3)));
+    }
+    if required_only {
+        return cols;
     }
     for a in &cl.axes {
         let inp = |name: &str, scale: f64| match cl.input(name) {
@@ -61,24 +90,31 @@ fn columns(cl: &ClosedLoop) -> Vec<(String, Source)> {
     cols
 }
 
-/// The run as CSV text (comma separated, one header line, fixed 10-decimal numbers so that
-/// output is byte-identical across runs).
-pub fn to_csv(cl: &ClosedLoop, run: &Run) -> Vec<u8> {
-    let cols = columns(cl);
+/// The run as CSV text (comma separated, one header line, a fixed number of decimals, so that
+/// output is byte-identical across runs and machines).
+pub fn to_csv(cl: &ClosedLoop, run: &Run, opts: &CsvOptions) -> Vec<u8> {
+    let cols = columns(cl, opts.required_only);
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(opts.seed);
+    let noise = Normal::new(0.0, opts.noise_um * 1e-3).ok().filter(|_| opts.noise_um > 0.0);
     let mut w = csv::Writer::from_writer(Vec::with_capacity(run.len() * cols.len() * 16));
     // Writing to memory cannot fail.
     let _ = w.write_record(cols.iter().map(|(n, _)| n.as_str()));
     let mut record = Vec::with_capacity(cols.len());
     for k in 0..run.len() {
         record.clear();
-        for (_, src) in &cols {
-            let v = match src {
+        for (name, src) in &cols {
+            let mut v = match src {
                 Source::Time => run.t_s[k],
                 Source::Output(i, s) => run.outputs[k * run.ny + i] * s,
                 Source::Input(i, s) => run.inputs[k * run.nu + i] * s,
                 Source::Zero => 0.0,
             };
-            let text = format!("{v:.10}");
+            if let Some(n) = &noise {
+                if name.ends_with("_ext_mm") {
+                    v += n.sample(&mut rng);
+                }
+            }
+            let text = format!("{v:.*}", opts.decimals);
             // A value that rounds to zero is written without a sign.
             if text.starts_with('-') && text[1..].bytes().all(|c| c == b'0' || c == b'.') {
                 record.push(text[1..].to_string());
