@@ -182,7 +182,7 @@ pub enum RtestError {
     },
     /// External minus internal beyond the R-Test measuring range.
     #[error(
-        "{at}: column {}: deviation {deviation_mm} mm from {} is beyond the R-Test range \
+        "{at}: column {}: deviation {deviation_mm:.4} mm from {} is beyond the R-Test range \
          ±{range_mm} mm{}",
         crate::rtest::series::EXT_COLUMNS[axis.index()],
         crate::rtest::series::INT_COLUMNS[axis.index()],

@@ -283,21 +283,26 @@ fn check_units(
     Ok(())
 }
 
-/// |external − internal| must stay within the R-Test range on every row and axis.
+/// |external − internal| must stay within the R-Test range on every row and axis. The error
+/// names the first row out of range; it suggests µm when most rows are out of range but all
+/// would be in range with the external column read as µm.
 fn check_probe_range(series: &CircleSeries) -> Result<(), RtestError> {
     for ax in Axis::ALL {
         let (int, ext) = (series.int_mm(ax), series.ext_mm(ax));
-        for (row, (&i, &e)) in int.iter().zip(ext).enumerate() {
-            let d = e - i;
-            if d.abs() > PROBE_RANGE_MM {
-                return Err(RtestError::ProbeRange {
-                    at: series.at_row(row),
-                    axis: ax,
-                    deviation_mm: d,
-                    range_mm: PROBE_RANGE_MM,
-                    looks_like_um: (e * 1e-3 - i).abs() <= PROBE_RANGE_MM,
-                });
-            }
+        let out_of_range = |(&i, &e): (&f64, &f64)| (e - i).abs() > PROBE_RANGE_MM;
+        if let Some(row) = int.iter().zip(ext).position(out_of_range) {
+            let outside = int.iter().zip(ext).filter(|p| out_of_range(*p)).count();
+            let as_um_in_range = int
+                .iter()
+                .zip(ext)
+                .all(|(&i, &e)| (e * 1e-3 - i).abs() <= PROBE_RANGE_MM);
+            return Err(RtestError::ProbeRange {
+                at: series.at_row(row),
+                axis: ax,
+                deviation_mm: ext[row] - int[row],
+                range_mm: PROBE_RANGE_MM,
+                looks_like_um: as_um_in_range && 2 * outside > int.len(),
+            });
         }
     }
     Ok(())

@@ -246,3 +246,15 @@ pub fn scratch_dir(name: &str) -> std::path::PathBuf {
     std::fs::create_dir_all(&d).expect("scratch dir");
     d
 }
+
+/// CSV text in the documented column order from columns t, int[x,y,z], ext[x,y,z].
+pub fn csv_text(t: &[f64], int: &[Vec<f64>; 3], ext: &[Vec<f64>; 3]) -> String {
+    let mut s = String::from("t_s,x_int_mm,y_int_mm,z_int_mm,x_ext_mm,y_ext_mm,z_ext_mm\n");
+    for i in 0..t.len() {
+        s.push_str(&format!(
+            "{},{},{},{},{},{},{}\n",
+            t[i], int[0][i], int[1][i], int[2][i], ext[0][i], ext[1][i], ext[2][i]
+        ));
+    }
+    s
+}
