@@ -181,3 +181,14 @@ fn eij_table_round_trips_and_is_strict() {
     assert_eq!(table::read(&p).unwrap()[0].std_err, None);
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// The shipped table of the paper's values reads back with the documented single row.
+#[test]
+fn paper_table_is_a_valid_eij_table() {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("measurements/paper/eij_table.csv");
+    let rows = table::read(&path).unwrap();
+    assert_eq!(rows.len(), 1);
+    assert_eq!(rows[0].parameter, Eij::new(Axis::X, Axis::Z));
+    assert_eq!(rows[0].value, -1.55);
+}

@@ -118,7 +118,7 @@ fn routes_agree_with_theory_noise_free() {
                 let e_ii = truth[&eij::axes::Eij::new(i, i)];
                 let e_ij = truth[&eij::axes::Eij::new(i, j)];
                 let exact = (1.0 - ((1.0 - k * e_ii).powi(2) + (k * e_ij).powi(2)).sqrt()) / k;
-                let got = r.ellipse_fit.eij[&eij::axes::Eij::new(i, i)];
+                let got = r.ellipse_fit.as_ref().unwrap().eij[&eij::axes::Eij::new(i, i)];
                 assert!(
                     (got - exact).abs() < 1e-9,
                     "{plane} a={accel}: ellipse E{i}{i} = {got}, theory {exact}"
@@ -172,5 +172,27 @@ fn evaluation_time_of_a_10k_series() {
         r.samples_used,
         per
     );
+    let start = std::time::Instant::now();
+    for _ in 0..reps {
+        std::hint::black_box(eij::rtest::evaluate_joint(&series, &opts).unwrap());
+    }
+    println!(
+        "evaluate_joint: {:?} per evaluation",
+        start.elapsed() / reps
+    );
     assert!(series.len() > 10_000);
+}
+
+/// A set radius that is no positive number is refused, not used.
+#[test]
+fn bad_set_radius_is_refused() {
+    let s = Synth::new(Plane::Xy, true, 5.0).series();
+    for r in [0.0, -2.0, f64::NAN] {
+        let opts = EvalOptions {
+            radius_mm: Some(r),
+            ..Default::default()
+        };
+        let err = evaluate(&s, &opts).unwrap_err().to_string();
+        assert!(err.contains("must be a positive number of mm"), "{err}");
+    }
 }

@@ -109,7 +109,9 @@ fn render_result(out: &mut String, r: &CircleResult) {
             r.eij[&p],
             r.std_err[&p],
             route(&r.plane_fit.eij),
-            route(&r.ellipse_fit.eij)
+            r.ellipse_fit
+                .as_ref()
+                .map_or(String::new(), |e| route(&e.eij))
         );
     }
     let _ = writeln!(out, "  rms residual {:.4} µm", r.rms_residual_um);

@@ -74,6 +74,15 @@ impl Normalised {
 /// otherwise rotate the acceleration vector and leak in-talk into cross-talk.
 pub fn normalise(series: &CircleSeries, opts: &EvalOptions) -> Result<Normalised, RtestError> {
     let whole = || Location::source(series.source());
+    if let Some(r) = opts.radius_mm {
+        if !(r.is_finite() && r > 0.0) {
+            return Err(RtestError::BadValue {
+                at: whole(),
+                column: "radius_mm".into(),
+                message: format!("set radius {r} must be a positive number of mm"),
+            });
+        }
+    }
     let amp_int = Axis::ALL.map(|ax| half_amplitude(series.int_mm(ax)));
     let amp_ext = Axis::ALL.map(|ax| half_amplitude(series.ext_mm(ax)));
     let plane = match opts.plane {
