@@ -192,3 +192,29 @@ fn paper_table_is_a_valid_eij_table() {
     assert_eq!(rows[0].parameter, Eij::new(Axis::X, Axis::Z));
     assert_eq!(rows[0].value, -1.55);
 }
+
+/// Spreadsheet habits are tolerated where harmless: a byte-order mark, CRLF line ends, blank
+/// lines, spaces around cells; line numbers still count every physical line.
+#[test]
+fn byte_order_mark_crlf_and_blank_lines() {
+    let d = scratch_dir("input-bom");
+    let p = d.join("bom.csv");
+    let text = "\u{feff}t_s, x_int_mm,y_int_mm,z_int_mm,x_ext_mm,y_ext_mm,z_ext_mm\r\n\
+                0,2,0,0,2,0,0\r\n\r\n\n0.001,2,0,0,2,0,0\r\n0.0005,2,0,0,2,0,0\r\n";
+    std::fs::write(&p, text).unwrap();
+    let err = CircleSeries::read_csv(&p).unwrap_err().to_string();
+    assert_eq!(
+        err,
+        format!(
+            "{}:6: t_s = 0.0005 does not increase (previous row 0.001)",
+            p.display()
+        )
+    );
+    std::fs::write(&p, text.replace("0.0005,2,0,0,2,0,0", "0.0005,2")).unwrap();
+    let err = CircleSeries::read_csv(&p).unwrap_err().to_string();
+    assert_eq!(
+        err,
+        format!("{}:6: 2 field(s), the header has 7", p.display())
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}

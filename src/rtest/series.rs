@@ -95,6 +95,7 @@ impl CircleSeries {
             .has_headers(false)
             .trim(csv::Trim::All)
             .from_reader(bytes.as_slice());
+        let mut counter = LineCounter::new(&bytes);
         let mut records = reader.records();
         let header = match records.next() {
             None => {
@@ -103,9 +104,9 @@ impl CircleSeries {
                     expected: required_columns().join(","),
                 })
             }
-            Some(r) => r.map_err(|e| csv_error(&name, e))?,
+            Some(r) => r.map_err(|e| csv_error(&name, &mut counter, e))?,
         };
-        let header_at = Location::file_line(&name, header.position().map_or(1, |p| p.line()));
+        let header_at = Location::file_line(&name, counter.line_of_record(&header));
         let required = required_columns();
         let mut index = [usize::MAX; 7];
         for (i, cell) in header.iter().enumerate() {
@@ -134,8 +135,8 @@ impl CircleSeries {
         let mut cols: [Vec<f64>; 7] = Default::default();
         let mut lines = Vec::new();
         for record in records {
-            let record = record.map_err(|e| csv_error(&name, e))?;
-            let line = record.position().map_or(0, |p| p.line());
+            let record = record.map_err(|e| csv_error(&name, &mut counter, e))?;
+            let line = counter.line_of_record(&record);
             for (k, col) in cols.iter_mut().enumerate() {
                 let text = record.get(index[k]).unwrap_or("");
                 col.push(parse_number(text, &name, line, required[k])?);
@@ -230,6 +231,7 @@ fn required_columns() -> [&'static str; 7] {
 }
 
 /// Reads a whole file, telling "not found" and "is a folder" apart from other failures.
+/// A UTF-8 byte-order mark (as some spreadsheet exports write) is dropped.
 pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>, RtestError> {
     let name = path.display().to_string();
     match std::fs::metadata(path) {
@@ -248,15 +250,74 @@ pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>, RtestError> {
         Ok(m) if m.is_dir() => return Err(RtestError::NotAFile { path: name }),
         Ok(_) => {}
     }
-    std::fs::read(path).map_err(|e| RtestError::Io {
+    let mut bytes = std::fs::read(path).map_err(|e| RtestError::Io {
         path: name,
         message: e.to_string(),
-    })
+    })?;
+    if bytes.starts_with(b"\xEF\xBB\xBF") {
+        bytes.drain(..3);
+    }
+    Ok(bytes)
+}
+
+/// Physical line numbers (1-based) of byte offsets, counted forward through the file: the CSV
+/// reader's own line count leaves out blank lines.
+pub(crate) struct LineCounter<'a> {
+    bytes: &'a [u8],
+    byte: usize,
+    line: u64,
+}
+
+impl<'a> LineCounter<'a> {
+    /// A counter at the start of `bytes` (line 1).
+    pub(crate) fn new(bytes: &'a [u8]) -> Self {
+        LineCounter {
+            bytes,
+            byte: 0,
+            line: 1,
+        }
+    }
+
+    /// The line holding byte `offset`; offsets must not decrease between calls.
+    pub(crate) fn line_of(&mut self, offset: u64) -> u64 {
+        let end = (offset as usize).min(self.bytes.len());
+        if end > self.byte {
+            let newlines = self.bytes[self.byte..end]
+                .iter()
+                .filter(|&&b| b == b'\n')
+                .count();
+            self.line += newlines as u64;
+            self.byte = end;
+        }
+        self.line
+    }
+
+    /// The line of a record: of its first byte that is not a line end (the reader's record
+    /// position may point at the end of the previous line or at skipped blank lines).
+    pub(crate) fn line_of_record(&mut self, record: &csv::StringRecord) -> u64 {
+        match record.position() {
+            Some(p) => self.line_of_position(p),
+            None => self.line,
+        }
+    }
+
+    /// The line of a reader position, skipping line ends as [`Self::line_of_record`] does.
+    pub(crate) fn line_of_position(&mut self, p: &csv::Position) -> u64 {
+        let mut start = p.byte() as usize;
+        while self
+            .bytes
+            .get(start)
+            .is_some_and(|b| *b == b'\r' || *b == b'\n')
+        {
+            start += 1;
+        }
+        self.line_of(start as u64)
+    }
 }
 
 /// Turns a CSV reader error into a one-line error naming the line.
-pub(crate) fn csv_error(source: &str, e: csv::Error) -> RtestError {
-    let line = e.position().map(|p| p.line());
+pub(crate) fn csv_error(source: &str, lines: &mut LineCounter, e: csv::Error) -> RtestError {
+    let line = e.position().map(|p| lines.line_of_position(p));
     let message = match e.kind() {
         csv::ErrorKind::UnequalLengths {
             expected_len, len, ..

@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::error::{Location, RtestError};
-use super::series::{csv_error, parse_number, read_file};
+use super::series::{csv_error, parse_number, read_file, LineCounter};
 use super::CircleResult;
 use crate::axes::{Direction, Eij, Plane};
 
@@ -67,6 +67,7 @@ pub fn read(path: impl AsRef<Path>) -> Result<Vec<EijRow>, RtestError> {
         .has_headers(false)
         .trim(csv::Trim::All)
         .from_reader(bytes.as_slice());
+    let mut counter = LineCounter::new(&bytes);
     let mut records = reader.records();
     let expected = || format!("{},{}", COLUMNS.join(","), STD_ERR_COLUMN);
     let header = match records.next() {
@@ -76,9 +77,9 @@ pub fn read(path: impl AsRef<Path>) -> Result<Vec<EijRow>, RtestError> {
                 expected: expected(),
             })
         }
-        Some(r) => r.map_err(|e| csv_error(&name, e))?,
+        Some(r) => r.map_err(|e| csv_error(&name, &mut counter, e))?,
     };
-    let header_at = Location::file_line(&name, header.position().map_or(1, |p| p.line()));
+    let header_at = Location::file_line(&name, counter.line_of_record(&header));
     let mut index = [usize::MAX; 6];
     for (i, cell) in header.iter().enumerate() {
         let k = COLUMNS
@@ -112,8 +113,8 @@ pub fn read(path: impl AsRef<Path>) -> Result<Vec<EijRow>, RtestError> {
     }
     let mut rows = Vec::new();
     for record in records {
-        let record = record.map_err(|e| csv_error(&name, e))?;
-        let line = record.position().map_or(0, |p| p.line());
+        let record = record.map_err(|e| csv_error(&name, &mut counter, e))?;
+        let line = counter.line_of_record(&record);
         let at = || Location::file_line(&name, line);
         let cell = |k: usize| record.get(index[k]).unwrap_or("");
         let bad = |k: usize, message: String| RtestError::BadValue {
