@@ -1,1 +1,230 @@
 //! R-Test circle-test evaluation (paper section 2.3): read, normalise, fit EIJ.
+//!
+//! ```text
+//! CSV / simulator ─► CircleSeries ─► normalise (eq. 5–6) ─► joint fit (primary)
+//!                                                       ├─► plane fit   (paper, cross-talk)
+//!                                                       └─► ellipse fit (paper, in-talk)
+//! several series of one plane ─► pooled (separates static geometry from EIJ)
+//! ```
+
+use std::collections::BTreeMap;
+
+use serde_json::{json, Map, Value};
+
+use crate::axes::{Axis, Direction, Eij, Plane};
+
+pub mod error;
+pub mod fit;
+pub mod normalise;
+pub mod pooled;
+pub mod series;
+pub mod table;
+
+pub use error::{Line, Location, RtestError};
+pub use pooled::{evaluate_pooled, PooledResult};
+pub use series::CircleSeries;
+
+/// Options of [`evaluate`]; `None` means "infer from the data".
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct EvalOptions {
+    /// The circle plane; inferred as the two axes with the largest internal amplitude.
+    pub plane: Option<Plane>,
+    /// The set radius, mm; the mean internal radius is used when absent. When given, the mean
+    /// internal radius must lie within 10 % of it.
+    pub radius_mm: Option<f64>,
+}
+
+/// The paper's plane-fit route to the cross-talk E_ka, E_kb (see [`fit::plane_route`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlaneFit {
+    /// E_ka, E_kb, µm·s²/m.
+    pub eij: BTreeMap<Eij, f64>,
+    /// Their standard errors, µm·s²/m.
+    pub std_err: BTreeMap<Eij, f64>,
+}
+
+/// The evaluation of one circle test.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CircleResult {
+    /// File path or in-memory name.
+    pub source: String,
+    /// Circle plane.
+    pub plane: Plane,
+    /// Sense of rotation (sign of ω from the unwrapped phase).
+    pub direction: Direction,
+    /// Radius used for the set points, mm.
+    pub radius_mm: f64,
+    /// Mean internal radius over the steady revolutions, mm.
+    pub measured_radius_mm: f64,
+    /// Set acceleration magnitude r ω², m/s².
+    pub accel_m_s2: f64,
+    /// |ω| / 2π, Hz.
+    pub freq_hz: f64,
+    /// The six EIJ of the plane from the joint fit, µm·s²/m (primary result).
+    pub eij: BTreeMap<Eij, f64>,
+    /// Their standard errors, µm·s²/m.
+    pub std_err: BTreeMap<Eij, f64>,
+    /// Constant deviations per axis, µm.
+    pub offsets_um: BTreeMap<Axis, f64>,
+    /// Residual RMS of the joint fit over its three components, µm.
+    pub rms_residual_um: f64,
+    /// Steady whole revolutions used.
+    pub revolutions: usize,
+    /// Samples used.
+    pub samples_used: usize,
+    /// Cross-talk by the paper's plane fit.
+    pub plane_fit: PlaneFit,
+    /// In-talk by the paper's ellipse fit; `None` (with a warning) when a path is no ellipse.
+    pub ellipse_fit: Option<fit::EllipseRoute>,
+    /// Disagreements between the routes beyond noise (see [`evaluate`]).
+    pub warnings: Vec<String>,
+}
+
+/// The fast path for repeated use (e.g. inside identification): normalisation and the joint
+/// fit only, without the paper's routes and their comparison (about a third less time).
+pub fn evaluate_joint(
+    series: &CircleSeries,
+    opts: &EvalOptions,
+) -> Result<(normalise::Normalised, fit::JointFit), RtestError> {
+    let norm = normalise::normalise(series, opts)?;
+    let joint = fit::joint(&norm).ok_or_else(|| RtestError::Singular {
+        at: Location::source(series.source()),
+        detail: "the joint EIJ fit has no unique solution".into(),
+    })?;
+    Ok((norm, joint))
+}
+
+/// Evaluates one circle test: normalisation (eq. 5–6), joint fit (section 2.2), the paper's
+/// plane and ellipse routes, and their comparison.
+///
+/// A route is flagged in `warnings` when it differs from the joint fit by more than three
+/// combined standard errors, taking the joint fit's standard error `se` as the noise scale of
+/// both (combined: √2·se), plus 1e-9·(1 + |E|) for rounding. For the ellipse route the
+/// tolerance also holds the route's known truncation max|E|·(ε + g), with ε = 10⁻⁶ ω² max|E|
+/// and g the internal path's largest relative half-width error (see [`fit::EllipseRoute`]).
+pub fn evaluate(series: &CircleSeries, opts: &EvalOptions) -> Result<CircleResult, RtestError> {
+    let (norm, joint) = evaluate_joint(series, opts)?;
+    let (pf_eij, pf_se) = fit::plane_route(&norm).ok_or_else(|| RtestError::Singular {
+        at: Location::source(series.source()),
+        detail: "the plane fit has no unique solution".into(),
+    })?;
+    let (a, b) = norm.plane.axes();
+    let window = |v: &[f64]| -> Vec<f64> { v[norm.first..norm.end].to_vec() };
+    let (ia, ib) = (window(series.int_mm(a)), window(series.int_mm(b)));
+    let (ea, eb) = (window(series.ext_mm(a)), window(series.ext_mm(b)));
+    let ellipse = fit::ellipse_route(&norm, [&ia, &ib], [&ea, &eb]);
+
+    let tolerance = |p: &Eij| {
+        3.0 * std::f64::consts::SQRT_2 * joint.std_err[p] + 1e-9 * (1.0 + joint.eij[p].abs())
+    };
+    let mut warnings = Vec::new();
+    for (p, v) in &pf_eij {
+        let (j, s) = (joint.eij[p], joint.std_err[p]);
+        if (v - j).abs() > tolerance(p) {
+            warnings.push(format!(
+                "plane fit {p} = {v:.4} differs from the joint fit {j:.4} ± {s:.4} µm·s²/m"
+            ));
+        }
+    }
+    match &ellipse {
+        None => warnings.push("ellipse fit failed: a path is not an ellipse".into()),
+        Some(ellipse) => {
+            let in_plane_max = [a, b]
+                .iter()
+                .flat_map(|&i| [a, b].map(|j| joint.eij[&Eij::new(i, j)].abs()))
+                .fold(0.0, f64::max);
+            let eps = 1e-6 * norm.omega_rad_s * norm.omega_rad_s * in_plane_max;
+            let g = ellipse
+                .half_width_int_mm
+                .iter()
+                .map(|w| (w / norm.radius_mm - 1.0).abs())
+                .fold(0.0, f64::max);
+            let truncation = in_plane_max * (eps + g);
+            for (p, v) in &ellipse.eij {
+                let (j, s) = (joint.eij[p], joint.std_err[p]);
+                if (v - j).abs() > tolerance(p) + truncation {
+                    warnings.push(format!(
+                        "ellipse fit {p} = {v:.4} differs from the joint fit {j:.4} ± {s:.4} \
+                         µm·s²/m"
+                    ));
+                }
+            }
+        }
+    }
+    let direction = if norm.omega_rad_s > 0.0 {
+        Direction::Ccw
+    } else {
+        Direction::Cw
+    };
+    Ok(CircleResult {
+        source: series.source().to_string(),
+        plane: norm.plane,
+        direction,
+        radius_mm: norm.radius_mm,
+        measured_radius_mm: norm.measured_radius_mm,
+        accel_m_s2: norm.accel_m_s2(),
+        freq_hz: norm.freq_hz(),
+        eij: joint.eij,
+        std_err: joint.std_err,
+        offsets_um: joint.offsets_um,
+        rms_residual_um: joint.rms_residual_um,
+        revolutions: norm.revolutions,
+        samples_used: norm.samples(),
+        plane_fit: PlaneFit {
+            eij: pf_eij,
+            std_err: pf_se,
+        },
+        ellipse_fit: ellipse,
+        warnings,
+    })
+}
+
+/// A parameter map as a JSON object keyed by the parameter names (`EZZ`, ...).
+pub fn eij_json(map: &BTreeMap<Eij, f64>) -> Value {
+    Value::Object(map.iter().map(|(k, v)| (k.name(), json!(v))).collect())
+}
+
+impl CircleResult {
+    /// The CONTRACT.md JSON object of one test (`file`, `plane`, `direction`, `radius_mm`,
+    /// `accel_m_s2`, `freq_hz`, `eij_um_s2_per_m`, `std_err_um_s2_per_m`, `rms_residual_um`)
+    /// plus `measured_radius_mm`, `offsets_um`, `revolutions`, `samples_used`, `plane_fit`,
+    /// `ellipse_fit` (null when it failed) and `warnings`.
+    pub fn to_json(&self) -> Value {
+        let mut m = Map::new();
+        m.insert("file".into(), json!(self.source));
+        m.insert("plane".into(), json!(self.plane.name()));
+        m.insert("direction".into(), json!(self.direction.name()));
+        m.insert("radius_mm".into(), json!(self.radius_mm));
+        m.insert("accel_m_s2".into(), json!(self.accel_m_s2));
+        m.insert("freq_hz".into(), json!(self.freq_hz));
+        m.insert("eij_um_s2_per_m".into(), eij_json(&self.eij));
+        m.insert("std_err_um_s2_per_m".into(), eij_json(&self.std_err));
+        m.insert("rms_residual_um".into(), json!(self.rms_residual_um));
+        m.insert("measured_radius_mm".into(), json!(self.measured_radius_mm));
+        let offsets: Map<String, Value> = self
+            .offsets_um
+            .iter()
+            .map(|(k, v)| (k.name().to_string(), json!(v)))
+            .collect();
+        m.insert("offsets_um".into(), Value::Object(offsets));
+        m.insert("revolutions".into(), json!(self.revolutions));
+        m.insert("samples_used".into(), json!(self.samples_used));
+        m.insert(
+            "plane_fit".into(),
+            json!({
+                "eij_um_s2_per_m": eij_json(&self.plane_fit.eij),
+                "std_err_um_s2_per_m": eij_json(&self.plane_fit.std_err),
+            }),
+        );
+        let ellipse = self.ellipse_fit.as_ref().map_or(Value::Null, |e| {
+            json!({
+                "eij_um_s2_per_m": eij_json(&e.eij),
+                "half_width_int_mm": e.half_width_int_mm,
+                "half_width_ext_mm": e.half_width_ext_mm,
+            })
+        });
+        m.insert("ellipse_fit".into(), ellipse);
+        m.insert("warnings".into(), json!(self.warnings));
+        Value::Object(m)
+    }
+}

@@ -1,0 +1,271 @@
+//! Errors of the R-Test evaluation: every message is one line naming the source (file or
+//! in-memory series), the line or row where one applies, and what is wrong.
+
+use std::fmt;
+
+/// Where in a source a problem was found.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Location {
+    /// File path, or the name given to an in-memory series.
+    pub source: String,
+    /// Line in the file (1-based, the header is line 1) or row of an in-memory series.
+    pub line: Option<Line>,
+}
+
+/// A position inside a source.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Line {
+    /// Line of a text file, 1-based.
+    File(u64),
+    /// Row of an in-memory series, 1-based.
+    Row(usize),
+}
+
+impl Location {
+    /// The source as a whole.
+    pub fn source(source: &str) -> Self {
+        Location {
+            source: source.to_string(),
+            line: None,
+        }
+    }
+
+    /// A line of a file.
+    pub fn file_line(source: &str, line: u64) -> Self {
+        Location {
+            source: source.to_string(),
+            line: Some(Line::File(line)),
+        }
+    }
+}
+
+impl fmt::Display for Location {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.line {
+            None => write!(f, "{}", self.source),
+            Some(Line::File(l)) => write!(f, "{}:{}", self.source, l),
+            Some(Line::Row(r)) => write!(f, "{}: row {}", self.source, r),
+        }
+    }
+}
+
+/// Everything that can go wrong reading or evaluating circle tests and EIJ tables.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RtestError {
+    /// The file could not be opened or read.
+    #[error("{path}: cannot read: {message}")]
+    Io {
+        /// The path given.
+        path: String,
+        /// What the operating system said (or "file not found").
+        message: String,
+    },
+    /// The path names a folder.
+    #[error("{path}: is a folder, not a file")]
+    NotAFile {
+        /// The path given.
+        path: String,
+    },
+    /// No header line at all.
+    #[error("{at}: empty file (expected a header line with {expected})")]
+    Empty {
+        /// The file.
+        at: Location,
+        /// The required columns.
+        expected: String,
+    },
+    /// The file is not well-formed CSV (e.g. a row with the wrong number of fields).
+    #[error("{at}: {message}")]
+    Csv {
+        /// Where.
+        at: Location,
+        /// What the CSV reader found.
+        message: String,
+    },
+    /// Required columns are missing from the header.
+    #[error("{at}: missing column(s) {}", columns.join(", "))]
+    MissingColumns {
+        /// The header line.
+        at: Location,
+        /// The missing names.
+        columns: Vec<String>,
+    },
+    /// A required column appears twice.
+    #[error("{at}: duplicate column '{column}'")]
+    DuplicateColumn {
+        /// The header line.
+        at: Location,
+        /// The repeated name.
+        column: String,
+    },
+    /// A column that this reader does not know (EIJ tables only, to catch typos).
+    #[error("{at}: unknown column '{column}' (expected {expected})")]
+    UnknownColumn {
+        /// The header line.
+        at: Location,
+        /// The unknown name.
+        column: String,
+        /// The known names.
+        expected: String,
+    },
+    /// A cell that is not a number.
+    #[error("{at}: column {column}: '{value}' is not a number")]
+    NotANumber {
+        /// Where.
+        at: Location,
+        /// The column.
+        column: String,
+        /// The cell text.
+        value: String,
+    },
+    /// A cell that is NaN or infinite.
+    #[error("{at}: column {column}: '{value}' is not a finite number")]
+    NotFinite {
+        /// Where.
+        at: Location,
+        /// The column.
+        column: String,
+        /// The cell text.
+        value: String,
+    },
+    /// A cell with a value outside its domain (EIJ tables: plane, direction, parameter, ...).
+    #[error("{at}: column {column}: {message}")]
+    BadValue {
+        /// Where.
+        at: Location,
+        /// The column.
+        column: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// Fewer data rows than needed.
+    #[error("{at}: {rows} data row(s), at least {needed} needed")]
+    TooFewRows {
+        /// The source.
+        at: Location,
+        /// Rows found.
+        rows: usize,
+        /// Rows needed.
+        needed: usize,
+    },
+    /// Time does not increase strictly.
+    #[error("{at}: t_s = {t_s} does not increase (previous row {previous_t_s})")]
+    TimeNotIncreasing {
+        /// Where.
+        at: Location,
+        /// This row's time.
+        t_s: f64,
+        /// The previous row's time.
+        previous_t_s: f64,
+    },
+    /// Columns of an in-memory series differ in length.
+    #[error("{at}: column {column} has {len} values, t_s has {expected}")]
+    LengthMismatch {
+        /// The series.
+        at: Location,
+        /// The column.
+        column: String,
+        /// Its length.
+        len: usize,
+        /// The length of `t_s`.
+        expected: usize,
+    },
+    /// Values that are plausible only as micrometres in a millimetre column.
+    #[error("{at}: column {column}: {detail}; values look like µm, expected mm")]
+    LooksLikeMicrometres {
+        /// Where.
+        at: Location,
+        /// The column.
+        column: String,
+        /// The observation behind the guess.
+        detail: String,
+    },
+    /// External minus internal beyond the R-Test measuring range.
+    #[error(
+        "{at}: column {}: deviation {deviation_mm:.4} mm from {} is beyond the R-Test range \
+         ±{range_mm} mm{}",
+        crate::rtest::series::EXT_COLUMNS[axis.index()],
+        crate::rtest::series::INT_COLUMNS[axis.index()],
+        if *looks_like_um { " (values look like µm, expected mm)" } else { "" }
+    )]
+    ProbeRange {
+        /// Where.
+        at: Location,
+        /// The axis whose external column is out of range.
+        axis: crate::axes::Axis,
+        /// ext − int, mm.
+        deviation_mm: f64,
+        /// The range, mm.
+        range_mm: f64,
+        /// The external value read as µm would be in range.
+        looks_like_um: bool,
+    },
+    /// No circular motion in the internal readings.
+    #[error("{at}: no circular motion in the internal readings ({detail})")]
+    NoMotion {
+        /// The source.
+        at: Location,
+        /// Amplitudes seen.
+        detail: String,
+    },
+    /// The plane cannot be told from the data.
+    #[error("{at}: circle plane is ambiguous ({detail}); give --plane")]
+    AmbiguousPlane {
+        /// The source.
+        at: Location,
+        /// Amplitudes seen.
+        detail: String,
+    },
+    /// The measured radius is far from the set radius.
+    #[error(
+        "{at}: mean internal radius {measured_mm:.4} mm differs from the set radius \
+         {set_mm} mm by more than 10 %"
+    )]
+    RadiusMismatch {
+        /// The source.
+        at: Location,
+        /// Mean internal radius, mm.
+        measured_mm: f64,
+        /// Set radius, mm.
+        set_mm: f64,
+    },
+    /// Not enough steady motion to evaluate.
+    #[error("{at}: {detail}")]
+    TooShort {
+        /// The source.
+        at: Location,
+        /// What is missing.
+        detail: String,
+    },
+    /// A least-squares problem without a unique solution.
+    #[error("{at}: {detail}")]
+    Singular {
+        /// The source.
+        at: Location,
+        /// Which fit and why.
+        detail: String,
+    },
+    /// Inputs of a pooled evaluation that do not go together.
+    #[error("{at}: {detail}")]
+    Pooling {
+        /// The source that does not fit, or the whole set.
+        at: Location,
+        /// What is wrong.
+        detail: String,
+    },
+    /// Writing an output file failed.
+    #[error(transparent)]
+    Write(#[from] WriteFailure),
+}
+
+/// A failed output write (wraps [`crate::io::WriteError`], kept as text so that
+/// [`RtestError`] stays `Clone + PartialEq`).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct WriteFailure(pub String);
+
+impl From<crate::io::WriteError> for RtestError {
+    fn from(e: crate::io::WriteError) -> Self {
+        RtestError::Write(WriteFailure(e.to_string()))
+    }
+}

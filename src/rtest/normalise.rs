@@ -1,0 +1,459 @@
+//! Normalisation of a circle test (paper eq. 5–6): plane, centre, radius, phase, steady whole
+//! revolutions, ω and the set accelerations, plus the plausibility checks on units and range.
+
+use super::error::{Location, RtestError};
+use super::fit::lstsq;
+use super::series::{CircleSeries, EXT_COLUMNS, INT_COLUMNS};
+use super::EvalOptions;
+use crate::axes::{Axis, Plane};
+use nalgebra::DMatrix;
+use std::f64::consts::{PI, TAU};
+
+/// R-Test measuring range: |external − internal| must stay within this, mm.
+pub const PROBE_RANGE_MM: f64 = 3.0;
+/// Relative band around the plateau angular speed that counts as steady.
+pub const STEADY_TOLERANCE: f64 = 0.005;
+/// Fewest samples per revolution accepted.
+pub const MIN_SAMPLES_PER_REVOLUTION: usize = 36;
+/// Largest radius (mm) accepted for an R-Test circle before suspecting µm in mm columns.
+const MAX_PLAUSIBLE_RADIUS_MM: f64 = 50.0;
+/// Smallest in-plane half-amplitude (mm) that counts as motion.
+const MIN_MOTION_MM: f64 = 1e-3;
+
+/// A circle test reduced to its steady whole revolutions, in the plane's coordinates
+/// (a, b in-plane as in eq. 3–4, k the normal).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Normalised {
+    /// The circle plane.
+    pub plane: Plane,
+    /// Radius r used for the set points, mm (the given set radius, else the mean internal one).
+    pub radius_mm: f64,
+    /// Mean internal radius about the fitted centre over the steady revolutions, mm.
+    pub measured_radius_mm: f64,
+    /// Centre (a, b) of the internal path, mm.
+    pub centre_mm: [f64; 2],
+    /// Angular speed ω, rad/s, from a straight-line fit of the unwrapped phase over time;
+    /// positive is ccw.
+    pub omega_rad_s: f64,
+    /// First sample of the steady whole revolutions.
+    pub first: usize,
+    /// One past the last sample of the steady whole revolutions.
+    pub end: usize,
+    /// Number of whole revolutions in `first..end`.
+    pub revolutions: usize,
+    /// Set positions a_set = r cos φ, b_set = r sin φ (eq. 6), mm, over `first..end`.
+    pub set_mm: [Vec<f64>; 2],
+    /// Set accelerations ä_a = −r ω² cos φ, ä_b = −r ω² sin φ, m/s², over `first..end`.
+    pub acc_m_s2: [Vec<f64>; 2],
+    /// Structural deviation d = external − internal (section 2.2) along a, b, k, µm.
+    pub dev_um: [Vec<f64>; 3],
+}
+
+impl Normalised {
+    /// Set acceleration magnitude r ω², m/s².
+    pub fn accel_m_s2(&self) -> f64 {
+        self.radius_mm * 1e-3 * self.omega_rad_s * self.omega_rad_s
+    }
+
+    /// Revolutions per second |ω| / 2π.
+    pub fn freq_hz(&self) -> f64 {
+        self.omega_rad_s.abs() / TAU
+    }
+
+    /// Samples in the steady whole revolutions.
+    pub fn samples(&self) -> usize {
+        self.end - self.first
+    }
+}
+
+/// Normalises `series`: infers (or takes) the plane and radius, checks units and probe range,
+/// finds the steady whole revolutions and computes the phase φ_k = atan2(b − b_c, a − a_c) from
+/// the internal readings (eq. 5), the set points and set accelerations (eq. 6).
+///
+/// The phase comes from the internal readings, never from time: a servo lag of 2° would
+/// otherwise rotate the acceleration vector and leak in-talk into cross-talk.
+pub fn normalise(series: &CircleSeries, opts: &EvalOptions) -> Result<Normalised, RtestError> {
+    let whole = || Location::source(series.source());
+    if let Some(r) = opts.radius_mm {
+        if !(r.is_finite() && r > 0.0) {
+            return Err(RtestError::BadValue {
+                at: whole(),
+                column: "radius_mm".into(),
+                message: format!("set radius {r} must be a positive number of mm"),
+            });
+        }
+    }
+    let amp_int = Axis::ALL.map(|ax| half_amplitude(series.int_mm(ax)));
+    let amp_ext = Axis::ALL.map(|ax| half_amplitude(series.ext_mm(ax)));
+    let plane = match opts.plane {
+        Some(p) => p,
+        None => infer_plane(&amp_int, &whole)?,
+    };
+    let (a, b) = plane.axes();
+    let k = plane.normal();
+    for ax in [a, b] {
+        if amp_int[ax.index()] < MIN_MOTION_MM {
+            return Err(RtestError::NoMotion {
+                at: whole(),
+                detail: format!(
+                    "{} moves ±{:.3e} mm in plane {plane}",
+                    INT_COLUMNS[ax.index()],
+                    amp_int[ax.index()]
+                ),
+            });
+        }
+    }
+    check_units(series, plane, &amp_int, &amp_ext, opts.radius_mm)?;
+    check_probe_range(series)?;
+
+    let (ai, bi) = (series.int_mm(a), series.int_mm(b));
+    let t = series.t_s();
+    // The mid-range is centre enough to find the steady part; the least-squares centre of the
+    // steady revolutions follows.
+    let centre0 = [mid_range(ai), mid_range(bi)];
+    let phase0 = unwrapped_phase(ai, bi, centre0);
+    let (first, end, revolutions) = steady_revolutions(t, &phase0, &whole)?;
+    let spr = (end - first) / revolutions;
+    if spr < MIN_SAMPLES_PER_REVOLUTION {
+        return Err(RtestError::TooShort {
+            at: whole(),
+            detail: format!(
+                "only {spr} samples per revolution, at least {MIN_SAMPLES_PER_REVOLUTION} needed"
+            ),
+        });
+    }
+
+    let (aw, bw) = (&ai[first..end], &bi[first..end]);
+    let centre = circle_centre(aw, bw).ok_or_else(|| RtestError::Singular {
+        at: whole(),
+        detail: "cannot fit the centre of the steady revolutions".into(),
+    })?;
+    let phase = unwrapped_phase(aw, bw, centre);
+    let n = phase.len();
+    // cos φ and sin φ straight from the readings: (a − a_c)/ρ, (b − b_c)/ρ.
+    let mut cos_sin = Vec::with_capacity(n);
+    let mut radius_sum = 0.0;
+    for (x, y) in aw.iter().zip(bw) {
+        let (u, v) = (x - centre[0], y - centre[1]);
+        let rho = (u * u + v * v).sqrt();
+        radius_sum += rho;
+        cos_sin.push((u / rho, v / rho));
+    }
+    let measured_radius_mm = radius_sum / n as f64;
+    let radius_mm = match opts.radius_mm {
+        Some(set) => {
+            if (measured_radius_mm - set).abs() > 0.1 * set {
+                return Err(RtestError::RadiusMismatch {
+                    at: whole(),
+                    measured_mm: measured_radius_mm,
+                    set_mm: set,
+                });
+            }
+            set
+        }
+        None => measured_radius_mm,
+    };
+    let omega_rad_s = slope(&t[first..end], &phase);
+
+    let r_m = radius_mm * 1e-3;
+    let w2 = omega_rad_s * omega_rad_s;
+    let mut set_mm = [Vec::with_capacity(n), Vec::with_capacity(n)];
+    let mut acc_m_s2 = [Vec::with_capacity(n), Vec::with_capacity(n)];
+    for &(c, s) in &cos_sin {
+        set_mm[0].push(radius_mm * c);
+        set_mm[1].push(radius_mm * s);
+        acc_m_s2[0].push(-r_m * w2 * c);
+        acc_m_s2[1].push(-r_m * w2 * s);
+    }
+    let dev_um = [a, b, k].map(|ax| {
+        series.ext_mm(ax)[first..end]
+            .iter()
+            .zip(&series.int_mm(ax)[first..end])
+            .map(|(e, i)| (e - i) * 1e3)
+            .collect()
+    });
+    Ok(Normalised {
+        plane,
+        radius_mm,
+        measured_radius_mm,
+        centre_mm: centre,
+        omega_rad_s,
+        first,
+        end,
+        revolutions,
+        set_mm,
+        acc_m_s2,
+        dev_um,
+    })
+}
+
+fn min_max(v: &[f64]) -> (f64, f64) {
+    v.iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &x| {
+            (lo.min(x), hi.max(x))
+        })
+}
+
+fn half_amplitude(v: &[f64]) -> f64 {
+    let (lo, hi) = min_max(v);
+    (hi - lo) / 2.0
+}
+
+fn mid_range(v: &[f64]) -> f64 {
+    let (lo, hi) = min_max(v);
+    (hi + lo) / 2.0
+}
+
+/// The plane of the two axes with the largest internal amplitude; the third must be small.
+fn infer_plane(amp: &[f64; 3], whole: &dyn Fn() -> Location) -> Result<Plane, RtestError> {
+    let detail = || {
+        format!(
+            "half-amplitudes x {:.4} mm, y {:.4} mm, z {:.4} mm",
+            amp[0], amp[1], amp[2]
+        )
+    };
+    let mut order = [0usize, 1, 2];
+    order.sort_by(|&i, &j| amp[j].total_cmp(&amp[i]));
+    let (second, third) = (amp[order[1]], amp[order[2]]);
+    if second < MIN_MOTION_MM {
+        return Err(RtestError::NoMotion {
+            at: whole(),
+            detail: detail(),
+        });
+    }
+    if third > 0.2 * second {
+        return Err(RtestError::AmbiguousPlane {
+            at: whole(),
+            detail: detail(),
+        });
+    }
+    Ok(match order[2] {
+        0 => Plane::Yz,
+        1 => Plane::Zx,
+        _ => Plane::Xy,
+    })
+}
+
+/// Catches µm values written into mm columns: an external amplitude ≈ 1000× the internal one
+/// (or the reverse), or a circle far too large for an R-Test (or ≈ 1000× the set radius).
+fn check_units(
+    series: &CircleSeries,
+    plane: Plane,
+    amp_int: &[f64; 3],
+    amp_ext: &[f64; 3],
+    set_radius_mm: Option<f64>,
+) -> Result<(), RtestError> {
+    let whole = || Location::source(series.source());
+    let thousandfold = |ratio: f64| (300.0..3000.0).contains(&ratio);
+    let (a, b) = plane.axes();
+    for ax in [a, b] {
+        let (i, e) = (amp_int[ax.index()], amp_ext[ax.index()]);
+        if thousandfold(e / i) {
+            return Err(RtestError::LooksLikeMicrometres {
+                at: whole(),
+                column: EXT_COLUMNS[ax.index()].into(),
+                detail: format!(
+                    "amplitude ±{e:.4} is {:.0}× that of {}",
+                    e / i,
+                    INT_COLUMNS[ax.index()]
+                ),
+            });
+        }
+        if e > 0.0 && thousandfold(i / e) {
+            return Err(RtestError::LooksLikeMicrometres {
+                at: whole(),
+                column: INT_COLUMNS[ax.index()].into(),
+                detail: format!(
+                    "amplitude ±{i:.4} is {:.0}× that of {}",
+                    i / e,
+                    EXT_COLUMNS[ax.index()]
+                ),
+            });
+        }
+    }
+    let r0 = 0.5 * (amp_int[a.index()] + amp_int[b.index()]);
+    let column = INT_COLUMNS[a.index()].to_string();
+    if r0 > MAX_PLAUSIBLE_RADIUS_MM {
+        return Err(RtestError::LooksLikeMicrometres {
+            at: whole(),
+            column,
+            detail: format!("circle radius {r0:.1} is implausible for an R-Test circle"),
+        });
+    }
+    if let Some(set) = set_radius_mm {
+        if thousandfold(r0 / set) {
+            return Err(RtestError::LooksLikeMicrometres {
+                at: whole(),
+                column,
+                detail: format!("circle radius {r0:.1} is {:.0}× the set radius", r0 / set),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// |external − internal| must stay within the R-Test range on every row and axis. The error
+/// names the first row out of range; it suggests µm when most rows are out of range but all
+/// would be in range with the external column read as µm.
+fn check_probe_range(series: &CircleSeries) -> Result<(), RtestError> {
+    for ax in Axis::ALL {
+        let (int, ext) = (series.int_mm(ax), series.ext_mm(ax));
+        let out_of_range = |(&i, &e): (&f64, &f64)| (e - i).abs() > PROBE_RANGE_MM;
+        if let Some(row) = int.iter().zip(ext).position(out_of_range) {
+            let outside = int.iter().zip(ext).filter(|p| out_of_range(*p)).count();
+            let as_um_in_range = int
+                .iter()
+                .zip(ext)
+                .all(|(&i, &e)| (e * 1e-3 - i).abs() <= PROBE_RANGE_MM);
+            return Err(RtestError::ProbeRange {
+                at: series.at_row(row),
+                axis: ax,
+                deviation_mm: ext[row] - int[row],
+                range_mm: PROBE_RANGE_MM,
+                looks_like_um: as_um_in_range && 2 * outside > int.len(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Algebraic (Kåsa) circle fit a² + b² = 2 a_c a + 2 b_c b + c by QR least squares, on
+/// mean-centred data for conditioning. Returns the centre (a_c, b_c).
+pub fn circle_centre(a: &[f64], b: &[f64]) -> Option<[f64; 2]> {
+    let n = a.len();
+    let (ma, mb) = (mean(a), mean(b));
+    let x = DMatrix::from_fn(n, 3, |i, j| match j {
+        0 => a[i] - ma,
+        1 => b[i] - mb,
+        _ => 1.0,
+    });
+    let y = DMatrix::from_fn(n, 1, |i, _| {
+        let (u, v) = (a[i] - ma, b[i] - mb);
+        u * u + v * v
+    });
+    let fit = lstsq(x, y)?;
+    Some([ma + 0.5 * fit.coef[(0, 0)], mb + 0.5 * fit.coef[(1, 0)]])
+}
+
+fn mean(v: &[f64]) -> f64 {
+    v.iter().sum::<f64>() / v.len() as f64
+}
+
+/// φ_k = atan2(b − b_c, a − a_c) (eq. 5), unwrapped to a continuous sequence.
+pub fn unwrapped_phase(a: &[f64], b: &[f64], centre: [f64; 2]) -> Vec<f64> {
+    let mut out = Vec::with_capacity(a.len());
+    let mut prev_raw = 0.0;
+    let mut acc = 0.0;
+    for (i, (x, y)) in a.iter().zip(b).enumerate() {
+        let raw = (y - centre[1]).atan2(x - centre[0]);
+        if i == 0 {
+            acc = raw;
+        } else {
+            let mut d = raw - prev_raw;
+            if d > PI {
+                d -= TAU;
+            } else if d < -PI {
+                d += TAU;
+            }
+            acc += d;
+        }
+        prev_raw = raw;
+        out.push(acc);
+    }
+    out
+}
+
+/// Least-squares slope of y over t (straight line with intercept).
+fn slope(t: &[f64], y: &[f64]) -> f64 {
+    let (mt, my) = (mean(t), mean(y));
+    let (mut sty, mut stt) = (0.0, 0.0);
+    for (ti, yi) in t.iter().zip(y) {
+        sty += (ti - mt) * (yi - my);
+        stt += (ti - mt) * (ti - mt);
+    }
+    sty / stt
+}
+
+/// Finds the steady part and keeps only whole revolutions of it.
+///
+/// The local angular speed is the phase difference over a window of about 1/8 revolution
+/// (`±h` samples). The plateau speed is first taken as the 90th percentile of it and refined as
+/// the median over the plateau; the plateau is the longest run within [`STEADY_TOLERANCE`] of
+/// that speed. Of it the largest whole number of revolutions is kept, centred, so that the
+/// ramp-in and ramp-out are trimmed alike. Returns `(first, end, revolutions)`.
+fn steady_revolutions(
+    t: &[f64],
+    phase: &[f64],
+    whole: &dyn Fn() -> Location,
+) -> Result<(usize, usize, usize), RtestError> {
+    let n = phase.len();
+    let total = phase[n - 1] - phase[0];
+    let sign = if total >= 0.0 { 1.0 } else { -1.0 };
+    let too_short = |what: String| RtestError::TooShort {
+        at: whole(),
+        detail: what,
+    };
+    if total.abs() < TAU {
+        return Err(too_short(format!(
+            "only {:.2} revolution(s) in all, at least one whole steady revolution needed",
+            total.abs() / TAU
+        )));
+    }
+    let samples_per_rev = n as f64 * TAU / total.abs();
+    let h = ((samples_per_rev / 16.0) as usize).max(1);
+    if n < 2 * h + 3 {
+        return Err(too_short(format!("only {n} samples")));
+    }
+    let speed: Vec<f64> = (h..n - h)
+        .map(|k| sign * (phase[k + h] - phase[k - h]) / (t[k + h] - t[k - h]))
+        .collect();
+    let mut scratch = speed.clone();
+    let q90 = (scratch.len() * 9) / 10;
+    let (_, reference, _) = scratch.select_nth_unstable_by(q90, f64::total_cmp);
+    let reference = *reference;
+    if reference <= 0.0 {
+        return Err(too_short("no steady rotation found".into()));
+    }
+    let (mut k0, mut k1) = longest_run(&speed, reference);
+    let run = &mut scratch[..=k1 - k0];
+    run.copy_from_slice(&speed[k0..=k1]);
+    let mid = run.len() / 2;
+    let (_, median, _) = run.select_nth_unstable_by(mid, f64::total_cmp);
+    (k0, k1) = longest_run(&speed, *median);
+    let (k0, k1) = (k0 + h, k1 + h);
+    let span = sign * (phase[k1] - phase[k0]);
+    let revolutions = (span / TAU + 1e-9).floor();
+    if revolutions < 1.0 {
+        return Err(too_short(format!(
+            "only {:.2} steady revolution(s), at least one whole steady revolution needed",
+            span / TAU
+        )));
+    }
+    let slack = span - revolutions * TAU;
+    let first = (k0..=k1)
+        .find(|&k| sign * (phase[k] - phase[k0]) >= 0.5 * slack)
+        .unwrap_or(k0);
+    let end = (first + 1..=k1)
+        .find(|&k| sign * (phase[k] - phase[first]) >= revolutions * TAU)
+        .unwrap_or(k1 + 1);
+    Ok((first, end, revolutions as usize))
+}
+
+/// Longest run of `speed` within [`STEADY_TOLERANCE`] of `reference`, as inclusive indices.
+fn longest_run(speed: &[f64], reference: f64) -> (usize, usize) {
+    let tol = STEADY_TOLERANCE * reference;
+    let (mut best, mut start) = ((0, 0), None);
+    let mut best_len = 0;
+    for (k, s) in speed.iter().enumerate() {
+        if (s - reference).abs() <= tol {
+            let s0 = *start.get_or_insert(k);
+            if k + 1 - s0 > best_len {
+                best_len = k + 1 - s0;
+                best = (s0, k);
+            }
+        } else {
+            start = None;
+        }
+    }
+    best
+}

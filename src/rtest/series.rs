@@ -1,0 +1,358 @@
+//! Circle-test time series (CONTRACT.md columns): strict CSV reader and in-memory constructor.
+
+use std::path::Path;
+
+use super::error::{Line, Location, RtestError};
+use crate::axes::Axis;
+
+/// Column names of the internal readings, x, y, z.
+pub const INT_COLUMNS: [&str; 3] = ["x_int_mm", "y_int_mm", "z_int_mm"];
+/// Column names of the external (R-Test) readings, x, y, z.
+pub const EXT_COLUMNS: [&str; 3] = ["x_ext_mm", "y_ext_mm", "z_ext_mm"];
+/// Column name of the time.
+pub const TIME_COLUMN: &str = "t_s";
+
+/// One circle test: time, internal readings (the axes' own measuring systems) and external
+/// readings (R-Test sphere centre relative to the nest), all relative to the circle centre.
+///
+/// Validated on construction: equal lengths, at least two rows, every value finite, time
+/// strictly increasing. The evaluation never re-checks these.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CircleSeries {
+    source: String,
+    t_s: Vec<f64>,
+    int_mm: [Vec<f64>; 3],
+    ext_mm: [Vec<f64>; 3],
+    /// File line of every row, when read from a file.
+    lines: Option<Vec<u64>>,
+}
+
+impl CircleSeries {
+    /// Builds a series from memory (e.g. handed over by the simulator), validating it like the
+    /// CSV reader does. `source` names the series in error messages; rows are counted from 1.
+    pub fn new(
+        source: String,
+        t_s: Vec<f64>,
+        int_mm: [Vec<f64>; 3],
+        ext_mm: [Vec<f64>; 3],
+    ) -> Result<Self, RtestError> {
+        let n = t_s.len();
+        let whole = Location::source(&source);
+        for (cols, names) in [(&int_mm, INT_COLUMNS), (&ext_mm, EXT_COLUMNS)] {
+            for (col, name) in cols.iter().zip(names) {
+                if col.len() != n {
+                    return Err(RtestError::LengthMismatch {
+                        at: whole,
+                        column: name.to_string(),
+                        len: col.len(),
+                        expected: n,
+                    });
+                }
+            }
+        }
+        let series = CircleSeries {
+            source,
+            t_s,
+            int_mm,
+            ext_mm,
+            lines: None,
+        };
+        for i in 0..n {
+            let cells = std::iter::once((TIME_COLUMN, series.t_s[i]))
+                .chain(
+                    INT_COLUMNS
+                        .iter()
+                        .zip(&series.int_mm)
+                        .map(|(c, v)| (*c, v[i])),
+                )
+                .chain(
+                    EXT_COLUMNS
+                        .iter()
+                        .zip(&series.ext_mm)
+                        .map(|(c, v)| (*c, v[i])),
+                );
+            for (column, v) in cells {
+                if !v.is_finite() {
+                    return Err(RtestError::NotFinite {
+                        at: series.at_row(i),
+                        column: column.to_string(),
+                        value: v.to_string(),
+                    });
+                }
+            }
+        }
+        series.check_rows_and_time()?;
+        Ok(series)
+    }
+
+    /// Reads a circle-test CSV (CONTRACT.md): one header line; required columns `t_s`,
+    /// `{x,y,z}_int_mm`, `{x,y,z}_ext_mm` in any order; other columns ignored.
+    pub fn read_csv(path: impl AsRef<Path>) -> Result<Self, RtestError> {
+        let path = path.as_ref();
+        let name = path.display().to_string();
+        let bytes = read_file(path)?;
+        let mut reader = csv::ReaderBuilder::new()
+            .has_headers(false)
+            .trim(csv::Trim::All)
+            .from_reader(bytes.as_slice());
+        let mut counter = LineCounter::new(&bytes);
+        let mut records = reader.records();
+        let header = match records.next() {
+            None => {
+                return Err(RtestError::Empty {
+                    at: Location::source(&name),
+                    expected: required_columns().join(","),
+                })
+            }
+            Some(r) => r.map_err(|e| csv_error(&name, &mut counter, e))?,
+        };
+        let header_at = Location::file_line(&name, counter.line_of_record(&header));
+        let required = required_columns();
+        let mut index = [usize::MAX; 7];
+        for (i, cell) in header.iter().enumerate() {
+            if let Some(k) = required.iter().position(|r| *r == cell) {
+                if index[k] != usize::MAX {
+                    return Err(RtestError::DuplicateColumn {
+                        at: header_at,
+                        column: cell.to_string(),
+                    });
+                }
+                index[k] = i;
+            }
+        }
+        let missing: Vec<String> = required
+            .iter()
+            .zip(index)
+            .filter(|(_, i)| *i == usize::MAX)
+            .map(|(r, _)| r.to_string())
+            .collect();
+        if !missing.is_empty() {
+            return Err(RtestError::MissingColumns {
+                at: header_at,
+                columns: missing,
+            });
+        }
+        let mut cols: [Vec<f64>; 7] = Default::default();
+        let mut lines = Vec::new();
+        for record in records {
+            let record = record.map_err(|e| csv_error(&name, &mut counter, e))?;
+            let line = counter.line_of_record(&record);
+            for (k, col) in cols.iter_mut().enumerate() {
+                let text = record.get(index[k]).unwrap_or("");
+                col.push(parse_number(text, &name, line, required[k])?);
+            }
+            lines.push(line);
+        }
+        let [t_s, xi, yi, zi, xe, ye, ze] = cols;
+        let series = CircleSeries {
+            source: name,
+            t_s,
+            int_mm: [xi, yi, zi],
+            ext_mm: [xe, ye, ze],
+            lines: Some(lines),
+        };
+        series.check_rows_and_time()?;
+        Ok(series)
+    }
+
+    fn check_rows_and_time(&self) -> Result<(), RtestError> {
+        if self.t_s.len() < 2 {
+            return Err(RtestError::TooFewRows {
+                at: Location::source(&self.source),
+                rows: self.t_s.len(),
+                needed: 2,
+            });
+        }
+        for i in 1..self.t_s.len() {
+            if self.t_s[i] <= self.t_s[i - 1] {
+                return Err(RtestError::TimeNotIncreasing {
+                    at: self.at_row(i),
+                    t_s: self.t_s[i],
+                    previous_t_s: self.t_s[i - 1],
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The file path or in-memory name.
+    pub fn source(&self) -> &str {
+        &self.source
+    }
+
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.t_s.len()
+    }
+
+    /// Always false: a valid series has at least two rows.
+    pub fn is_empty(&self) -> bool {
+        self.t_s.is_empty()
+    }
+
+    /// Time, s.
+    pub fn t_s(&self) -> &[f64] {
+        &self.t_s
+    }
+
+    /// Internal reading of `axis`, mm.
+    pub fn int_mm(&self, axis: Axis) -> &[f64] {
+        &self.int_mm[axis.index()]
+    }
+
+    /// External (R-Test) reading of `axis`, mm.
+    pub fn ext_mm(&self, axis: Axis) -> &[f64] {
+        &self.ext_mm[axis.index()]
+    }
+
+    /// Where sample `i` (0-based) came from: a file line or an in-memory row.
+    pub fn at_row(&self, i: usize) -> Location {
+        let line = match &self.lines {
+            Some(lines) => Line::File(lines.get(i).copied().unwrap_or(0)),
+            None => Line::Row(i + 1),
+        };
+        Location {
+            source: self.source.clone(),
+            line: Some(line),
+        }
+    }
+}
+
+fn required_columns() -> [&'static str; 7] {
+    [
+        TIME_COLUMN,
+        INT_COLUMNS[0],
+        INT_COLUMNS[1],
+        INT_COLUMNS[2],
+        EXT_COLUMNS[0],
+        EXT_COLUMNS[1],
+        EXT_COLUMNS[2],
+    ]
+}
+
+/// Reads a whole file, telling "not found" and "is a folder" apart from other failures.
+/// A UTF-8 byte-order mark (as some spreadsheet exports write) is dropped.
+pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>, RtestError> {
+    let name = path.display().to_string();
+    match std::fs::metadata(path) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Err(RtestError::Io {
+                path: name,
+                message: "file not found".into(),
+            })
+        }
+        Err(e) => {
+            return Err(RtestError::Io {
+                path: name,
+                message: e.to_string(),
+            })
+        }
+        Ok(m) if m.is_dir() => return Err(RtestError::NotAFile { path: name }),
+        Ok(_) => {}
+    }
+    let mut bytes = std::fs::read(path).map_err(|e| RtestError::Io {
+        path: name,
+        message: e.to_string(),
+    })?;
+    if bytes.starts_with(b"\xEF\xBB\xBF") {
+        bytes.drain(..3);
+    }
+    Ok(bytes)
+}
+
+/// Physical line numbers (1-based) of byte offsets, counted forward through the file: the CSV
+/// reader's own line count leaves out blank lines.
+pub(crate) struct LineCounter<'a> {
+    bytes: &'a [u8],
+    byte: usize,
+    line: u64,
+}
+
+impl<'a> LineCounter<'a> {
+    /// A counter at the start of `bytes` (line 1).
+    pub(crate) fn new(bytes: &'a [u8]) -> Self {
+        LineCounter {
+            bytes,
+            byte: 0,
+            line: 1,
+        }
+    }
+
+    /// The line holding byte `offset`; offsets must not decrease between calls.
+    pub(crate) fn line_of(&mut self, offset: u64) -> u64 {
+        let end = (offset as usize).min(self.bytes.len());
+        if end > self.byte {
+            let newlines = self.bytes[self.byte..end]
+                .iter()
+                .filter(|&&b| b == b'\n')
+                .count();
+            self.line += newlines as u64;
+            self.byte = end;
+        }
+        self.line
+    }
+
+    /// The line of a record: of its first byte that is not a line end (the reader's record
+    /// position may point at the end of the previous line or at skipped blank lines).
+    pub(crate) fn line_of_record(&mut self, record: &csv::StringRecord) -> u64 {
+        match record.position() {
+            Some(p) => self.line_of_position(p),
+            None => self.line,
+        }
+    }
+
+    /// The line of a reader position, skipping line ends as [`Self::line_of_record`] does.
+    pub(crate) fn line_of_position(&mut self, p: &csv::Position) -> u64 {
+        let mut start = p.byte() as usize;
+        while self
+            .bytes
+            .get(start)
+            .is_some_and(|b| *b == b'\r' || *b == b'\n')
+        {
+            start += 1;
+        }
+        self.line_of(start as u64)
+    }
+}
+
+/// Turns a CSV reader error into a one-line error naming the line.
+pub(crate) fn csv_error(source: &str, lines: &mut LineCounter, e: csv::Error) -> RtestError {
+    let line = e.position().map(|p| lines.line_of_position(p));
+    let message = match e.kind() {
+        csv::ErrorKind::UnequalLengths {
+            expected_len, len, ..
+        } => format!("{len} field(s), the header has {expected_len}"),
+        csv::ErrorKind::Utf8 { .. } => "not valid UTF-8 text".to_string(),
+        _ => e.to_string(),
+    };
+    RtestError::Csv {
+        at: Location {
+            source: source.to_string(),
+            line: line.map(Line::File),
+        },
+        message,
+    }
+}
+
+/// Parses one finite number, naming file, line and column otherwise.
+pub(crate) fn parse_number(
+    text: &str,
+    source: &str,
+    line: u64,
+    column: &str,
+) -> Result<f64, RtestError> {
+    let at = || Location::file_line(source, line);
+    match text.parse::<f64>() {
+        Err(_) => Err(RtestError::NotANumber {
+            at: at(),
+            column: column.to_string(),
+            value: text.to_string(),
+        }),
+        Ok(v) if !v.is_finite() => Err(RtestError::NotFinite {
+            at: at(),
+            column: column.to_string(),
+            value: text.to_string(),
+        }),
+        Ok(v) => Ok(v),
+    }
+}

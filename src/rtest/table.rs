@@ -1,0 +1,210 @@
+//! EIJ table (CONTRACT.md): `plane,direction,accel_m_s2,parameter,value_um_s2_per_m` and
+//! optionally `std_err_um_s2_per_m`, one row per parameter value. For values taken from a
+//! report, typed by hand, or written by `eij evaluate --csv-out`.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use super::error::{Location, RtestError};
+use super::series::{csv_error, parse_number, read_file, LineCounter};
+use super::CircleResult;
+use crate::axes::{Direction, Eij, Plane};
+
+/// Required columns, in the order written.
+pub const COLUMNS: [&str; 5] = [
+    "plane",
+    "direction",
+    "accel_m_s2",
+    "parameter",
+    "value_um_s2_per_m",
+];
+/// The optional standard-error column.
+pub const STD_ERR_COLUMN: &str = "std_err_um_s2_per_m";
+
+/// One parameter value of one test condition.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EijRow {
+    /// Circle plane.
+    pub plane: Plane,
+    /// Sense of rotation.
+    pub direction: Direction,
+    /// Set acceleration r ω², m/s².
+    pub accel_m_s2: f64,
+    /// The parameter; always one of the plane's six.
+    pub parameter: Eij,
+    /// Value, µm·s²/m.
+    pub value: f64,
+    /// Standard error, µm·s²/m, where known.
+    pub std_err: Option<f64>,
+}
+
+/// The six rows of one evaluated circle test.
+pub fn rows_from_result(result: &CircleResult) -> Vec<EijRow> {
+    result
+        .plane
+        .parameters()
+        .iter()
+        .map(|p| EijRow {
+            plane: result.plane,
+            direction: result.direction,
+            accel_m_s2: result.accel_m_s2,
+            parameter: *p,
+            value: result.eij[p],
+            std_err: result.std_err.get(p).copied(),
+        })
+        .collect()
+}
+
+/// Reads an EIJ table strictly: header with the five required columns (any order), the
+/// optional standard-error column, nothing else; every row a known plane and direction, a
+/// positive finite acceleration, a parameter of that plane, a finite value and, where given,
+/// a finite non-negative standard error (an empty cell means unknown). At least one row.
+pub fn read(path: impl AsRef<Path>) -> Result<Vec<EijRow>, RtestError> {
+    let path = path.as_ref();
+    let name = path.display().to_string();
+    let bytes = read_file(path)?;
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .trim(csv::Trim::All)
+        .from_reader(bytes.as_slice());
+    let mut counter = LineCounter::new(&bytes);
+    let mut records = reader.records();
+    let expected = || format!("{},{}", COLUMNS.join(","), STD_ERR_COLUMN);
+    let header = match records.next() {
+        None => {
+            return Err(RtestError::Empty {
+                at: Location::source(&name),
+                expected: expected(),
+            })
+        }
+        Some(r) => r.map_err(|e| csv_error(&name, &mut counter, e))?,
+    };
+    let header_at = Location::file_line(&name, counter.line_of_record(&header));
+    let mut index = [usize::MAX; 6];
+    for (i, cell) in header.iter().enumerate() {
+        let k = COLUMNS
+            .iter()
+            .chain([&STD_ERR_COLUMN])
+            .position(|c| *c == cell)
+            .ok_or_else(|| RtestError::UnknownColumn {
+                at: header_at.clone(),
+                column: cell.to_string(),
+                expected: expected(),
+            })?;
+        if index[k] != usize::MAX {
+            return Err(RtestError::DuplicateColumn {
+                at: header_at,
+                column: cell.to_string(),
+            });
+        }
+        index[k] = i;
+    }
+    let missing: Vec<String> = COLUMNS
+        .iter()
+        .zip(index)
+        .filter(|(_, i)| *i == usize::MAX)
+        .map(|(c, _)| c.to_string())
+        .collect();
+    if !missing.is_empty() {
+        return Err(RtestError::MissingColumns {
+            at: header_at,
+            columns: missing,
+        });
+    }
+    let mut rows = Vec::new();
+    for record in records {
+        let record = record.map_err(|e| csv_error(&name, &mut counter, e))?;
+        let line = counter.line_of_record(&record);
+        let at = || Location::file_line(&name, line);
+        let cell = |k: usize| record.get(index[k]).unwrap_or("");
+        let bad = |k: usize, message: String| RtestError::BadValue {
+            at: at(),
+            column: COLUMNS[k].to_string(),
+            message,
+        };
+        let plane: Plane = cell(0).parse().map_err(|m| bad(0, m))?;
+        let direction: Direction = cell(1).parse().map_err(|m| bad(1, m))?;
+        let accel_m_s2 = parse_number(cell(2), &name, line, COLUMNS[2])?;
+        if accel_m_s2 <= 0.0 {
+            return Err(bad(
+                2,
+                format!("acceleration {accel_m_s2} must be positive"),
+            ));
+        }
+        let parameter: Eij = cell(3).parse().map_err(|m| bad(3, m))?;
+        if !plane.parameters().contains(&parameter) {
+            return Err(bad(
+                3,
+                format!("{parameter} is not a parameter of plane {plane}"),
+            ));
+        }
+        let value = parse_number(cell(4), &name, line, COLUMNS[4])?;
+        let std_err = match index[5] {
+            usize::MAX => None,
+            i => match record.get(i).unwrap_or("") {
+                "" => None,
+                text => {
+                    let s = parse_number(text, &name, line, STD_ERR_COLUMN)?;
+                    if s < 0.0 {
+                        return Err(RtestError::BadValue {
+                            at: at(),
+                            column: STD_ERR_COLUMN.into(),
+                            message: format!("standard error {s} must not be negative"),
+                        });
+                    }
+                    Some(s)
+                }
+            },
+        };
+        rows.push(EijRow {
+            plane,
+            direction,
+            accel_m_s2,
+            parameter,
+            value,
+            std_err,
+        });
+    }
+    if rows.is_empty() {
+        return Err(RtestError::TooFewRows {
+            at: Location::source(&name),
+            rows: 0,
+            needed: 1,
+        });
+    }
+    Ok(rows)
+}
+
+/// The table as CSV text; the standard-error column is written when any row has one (empty
+/// cells for the others). Numbers use the shortest representation that reads back exactly.
+pub fn to_csv(rows: &[EijRow]) -> String {
+    let with_se = rows.iter().any(|r| r.std_err.is_some());
+    let mut out = COLUMNS.join(",");
+    if with_se {
+        out.push(',');
+        out.push_str(STD_ERR_COLUMN);
+    }
+    out.push('\n');
+    for r in rows {
+        let _ = write!(
+            out,
+            "{},{},{},{},{}",
+            r.plane, r.direction, r.accel_m_s2, r.parameter, r.value
+        );
+        if with_se {
+            out.push(',');
+            if let Some(s) = r.std_err {
+                let _ = write!(out, "{s}");
+            }
+        }
+        out.push('\n');
+    }
+    out
+}
+
+/// Writes the table atomically ([`crate::io::write_atomic`]); refuses to replace any of
+/// `inputs`.
+pub fn write(path: impl AsRef<Path>, rows: &[EijRow], inputs: &[&Path]) -> Result<(), RtestError> {
+    crate::io::write_atomic(path.as_ref(), to_csv(rows).as_bytes(), inputs)?;
+    Ok(())
+}

@@ -1,0 +1,349 @@
+//! `eij evaluate` end to end: the binary on good and bad files.
+
+mod rtest_common;
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use eij::axes::Plane;
+use eij::rtest::table;
+use rtest_common::{csv_text, scratch_dir, Synth};
+
+struct Run {
+    ok: bool,
+    stdout: String,
+    stderr: String,
+}
+
+fn eij(args: &[&str]) -> Run {
+    let out = Command::new(env!("CARGO_BIN_EXE_eij"))
+        .args(args)
+        .output()
+        .expect("run eij");
+    Run {
+        ok: out.status.success(),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    }
+}
+
+/// Non-zero exit, exactly one line on stderr naming `file` and every one of `needles`, no panic.
+fn assert_error(args: &[&str], file: &Path, needles: &[&str]) {
+    let r = eij(args);
+    assert!(!r.ok, "expected failure for {args:?}");
+    assert!(r.stdout.is_empty(), "stdout: {}", r.stdout);
+    let lines: Vec<&str> = r.stderr.lines().collect();
+    assert_eq!(lines.len(), 1, "stderr: {}", r.stderr);
+    let line = lines[0];
+    assert!(line.starts_with("eij: error: "), "{line}");
+    assert!(!line.contains("panicked"), "{line}");
+    assert!(line.contains(&file.display().to_string()), "{line}");
+    for n in needles {
+        assert!(line.contains(n), "'{n}' not in: {line}");
+    }
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+const HEADER: &str = "t_s,x_int_mm,y_int_mm,z_int_mm,x_ext_mm,y_ext_mm,z_ext_mm";
+
+#[test]
+fn malformed_files_name_file_line_and_column() {
+    let d = scratch_dir("cli-malformed");
+    let rows = "0,2,0,0,2.001,0,0\n0.001,1.9,0.6,0,1.9,0.6,0\n0.002,1.8,0.9,0,1.8,0.9,0\n";
+    let cases: Vec<(&str, String, Vec<String>)> = vec![
+        (
+            "missing.csv",
+            format!(
+                "t_s,x_int_mm,y_int_mm,z_int_mm,x_ext_mm,y_ext_mm\n{}",
+                "0,1,2,3,4,5\n"
+            ),
+            vec![":1: missing column(s) z_ext_mm".into()],
+        ),
+        (
+            "duplicate.csv",
+            format!("{HEADER},x_int_mm\n{rows}"),
+            vec![":1: duplicate column 'x_int_mm'".into()],
+        ),
+        (
+            "nan.csv",
+            format!("{HEADER}\n0,2,0,0,2,0,0\n0.001,2,0,0,2,NaN,0\n"),
+            vec![":3: column y_ext_mm: 'NaN' is not a finite number".into()],
+        ),
+        (
+            "inf.csv",
+            format!("{HEADER}\n0,2,0,0,2,0,0\n0.001,inf,0,0,2,0,0\n"),
+            vec![":3: column x_int_mm: 'inf' is not a finite number".into()],
+        ),
+        (
+            "text.csv",
+            format!("{HEADER}\n0,2,0,0,2,0,0\n0.001,2,0,0,2,0,0\n0.002,2,0,0,2,0,abc\n"),
+            vec![":4: column z_ext_mm: 'abc' is not a number".into()],
+        ),
+        (
+            "short_row.csv",
+            format!("{HEADER}\n0,2,0,0,2,0,0\n0.001,2,0\n"),
+            vec![":3: 3 field(s), the header has 7".into()],
+        ),
+        ("empty.csv", String::new(), vec![": empty file".into()]),
+        (
+            "header_only.csv",
+            format!("{HEADER}\n"),
+            vec![": 0 data row(s), at least 2 needed".into()],
+        ),
+        (
+            "backwards.csv",
+            format!("{HEADER}\n0,2,0,0,2,0,0\n0.002,2,0,0,2,0,0\n0.001,2,0,0,2,0,0\n"),
+            vec![":4: t_s = 0.001 does not increase".into()],
+        ),
+    ];
+    for (name, text, needles) in cases {
+        let p = write(&d, name, &text);
+        let needles: Vec<String> = needles
+            .iter()
+            .map(|n| {
+                if n.starts_with(':') {
+                    format!("{}{n}", p.display())
+                } else {
+                    n.clone()
+                }
+            })
+            .collect();
+        let needles: Vec<&str> = needles.iter().map(String::as_str).collect();
+        assert_error(&["evaluate", p.to_str().unwrap()], &p, &needles);
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn implausible_data_is_refused() {
+    let d = scratch_dir("cli-implausible");
+    // Less than one revolution in all.
+    let mut s = Synth::new(Plane::Xy, true, 5.0);
+    s.steady_revs = 0.3;
+    s.ramp_revs = 0.2;
+    let p = d.join("short.csv");
+    s.write_csv(&p);
+    assert_error(&["evaluate", p.to_str().unwrap()], &p, &["revolution"]);
+    // Revolutions, but less than one of them steady.
+    s.steady_revs = 0.6;
+    s.ramp_revs = 1.0;
+    s.write_csv(&p);
+    assert_error(
+        &["evaluate", p.to_str().unwrap()],
+        &p,
+        &["steady revolution(s), at least one whole steady revolution needed"],
+    );
+    // Too coarse sampling.
+    let mut s = Synth::new(Plane::Xy, true, 10.0);
+    s.sample_hz = 300.0;
+    let p = d.join("coarse.csv");
+    s.write_csv(&p);
+    assert_error(
+        &["evaluate", p.to_str().unwrap()],
+        &p,
+        &["samples per revolution"],
+    );
+    // Radius far from the set radius.
+    let p = d.join("radius.csv");
+    Synth::new(Plane::Zx, false, 5.0).write_csv(&p);
+    assert_error(
+        &["evaluate", p.to_str().unwrap(), "--radius-mm", "3"],
+        &p,
+        &["mean internal radius 2.0", "set radius 3 mm"],
+    );
+    // Beyond the ±3 mm R-Test range at one row (line = row + 2).
+    let (t, int, mut ext) = Synth::new(Plane::Zx, false, 5.0).columns();
+    ext[1][100] += 4.0;
+    let p = write(&d, "range.csv", &csv_text(&t, &int, &ext));
+    assert_error(
+        &["evaluate", p.to_str().unwrap()],
+        &p,
+        &[
+            &format!("{}:102: column y_ext_mm: deviation", p.display()),
+            "beyond the R-Test range ±3 mm",
+        ],
+    );
+    let r = eij(&["evaluate", p.to_str().unwrap()]);
+    assert!(
+        !r.stderr.contains("µm"),
+        "no µm hint for a single outlier: {}",
+        r.stderr
+    );
+    // µm in the in-plane external columns.
+    let (t, int, mut ext) = Synth::new(Plane::Xy, true, 5.0).columns();
+    for v in ext.iter_mut().take(2) {
+        v.iter_mut().for_each(|x| *x *= 1000.0);
+    }
+    let p = write(&d, "um_ext.csv", &csv_text(&t, &int, &ext));
+    assert_error(
+        &["evaluate", p.to_str().unwrap()],
+        &p,
+        &["column x_ext_mm", "values look like µm, expected mm"],
+    );
+    // µm everywhere: an implausibly large circle.
+    let (t, mut int, mut ext) = Synth::new(Plane::Xy, true, 5.0).columns();
+    for v in int.iter_mut().chain(ext.iter_mut()) {
+        v.iter_mut().for_each(|x| *x *= 1000.0);
+    }
+    let p = write(&d, "um_all.csv", &csv_text(&t, &int, &ext));
+    assert_error(
+        &["evaluate", p.to_str().unwrap()],
+        &p,
+        &[
+            "implausible for an R-Test circle",
+            "values look like µm, expected mm",
+        ],
+    );
+    // µm in the normal axis' external column: out of range, with the hint.
+    let (t, int, mut ext) = Synth::new(Plane::Xy, true, 5.0).columns();
+    ext[2].iter_mut().for_each(|x| *x = *x * 1000.0 + 4.0);
+    let p = write(&d, "um_normal.csv", &csv_text(&t, &int, &ext));
+    assert_error(
+        &["evaluate", p.to_str().unwrap()],
+        &p,
+        &[":2: column z_ext_mm", "values look like µm, expected mm"],
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn folders_and_missing_files_are_named() {
+    let d = scratch_dir("cli-paths");
+    assert_error(
+        &["evaluate", d.to_str().unwrap()],
+        &d,
+        &["is a folder, not a file"],
+    );
+    let p = d.join("nope.csv");
+    assert_error(&["evaluate", p.to_str().unwrap()], &p, &["file not found"]);
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn json_output_follows_the_contract() {
+    let d = scratch_dir("cli-json");
+    let syn = Synth::new(Plane::Zx, true, 5.0);
+    let p = d.join("zx_ccw_5.csv");
+    syn.write_csv(&p);
+    let out = d.join("eij.csv");
+    let r = eij(&[
+        "evaluate",
+        p.to_str().unwrap(),
+        "--json",
+        "--csv-out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    assert!(r.stderr.is_empty());
+    let v: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+    let top: Vec<&String> = v.as_object().unwrap().keys().collect();
+    assert_eq!(top, ["tests"]);
+    let tests = v["tests"].as_array().unwrap();
+    assert_eq!(tests.len(), 1);
+    let t = &tests[0];
+    for key in [
+        "file",
+        "plane",
+        "direction",
+        "radius_mm",
+        "accel_m_s2",
+        "freq_hz",
+        "eij_um_s2_per_m",
+        "std_err_um_s2_per_m",
+        "rms_residual_um",
+    ] {
+        assert!(t.get(key).is_some(), "missing key {key}");
+    }
+    assert_eq!(t["file"], p.to_str().unwrap());
+    assert_eq!(t["plane"], "zx");
+    assert_eq!(t["direction"], "ccw");
+    assert!((t["radius_mm"].as_f64().unwrap() - 2.0).abs() < 1e-3);
+    assert!((t["accel_m_s2"].as_f64().unwrap() - 5.0).abs() < 5e-3);
+    let f = (5.0f64 / 0.002).sqrt() / (2.0 * std::f64::consts::PI);
+    assert!((t["freq_hz"].as_f64().unwrap() - f).abs() < 1e-3 * f);
+    let names = ["EZZ", "EXX", "EXZ", "EZX", "EYZ", "EYX"];
+    for map in ["eij_um_s2_per_m", "std_err_um_s2_per_m"] {
+        let mut keys: Vec<&str> = t[map]
+            .as_object()
+            .unwrap()
+            .keys()
+            .map(|k| k.as_str())
+            .collect();
+        keys.sort();
+        let mut want = names.to_vec();
+        want.sort();
+        assert_eq!(keys, want, "{map}");
+    }
+    for (p, truth) in syn.truth() {
+        let got = t["eij_um_s2_per_m"][p.name()].as_f64().unwrap();
+        let se = t["std_err_um_s2_per_m"][p.name()].as_f64().unwrap();
+        assert!(
+            ((got - truth) / se).abs() < 3.0,
+            "{p}: {got} ± {se} vs {truth}"
+        );
+    }
+    assert!(t["warnings"].as_array().unwrap().is_empty());
+
+    // The EIJ table written alongside holds the same six values.
+    let rows = table::read(&out).unwrap();
+    assert_eq!(rows.len(), 6);
+    for row in rows {
+        assert_eq!(row.plane, Plane::Zx);
+        let json = t["eij_um_s2_per_m"][row.parameter.name()].as_f64().unwrap();
+        assert_eq!(row.value, json);
+        assert!(row.std_err.is_some());
+    }
+
+    // The same run again prints the same bytes.
+    let again = eij(&["evaluate", p.to_str().unwrap(), "--json"]);
+    assert_eq!(again.stdout, r.stdout);
+
+    // Never overwrite an input.
+    let before = std::fs::read(&p).unwrap();
+    assert_error(
+        &[
+            "evaluate",
+            p.to_str().unwrap(),
+            "--csv-out",
+            p.to_str().unwrap(),
+        ],
+        &p,
+        &["refusing to overwrite an input file"],
+    );
+    assert_eq!(std::fs::read(&p).unwrap(), before);
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn table_and_pooled_output() {
+    let d = scratch_dir("cli-pooled");
+    let mut files = Vec::new();
+    for (accel, ccw) in [(2.0, true), (10.0, false)] {
+        let p = d.join(format!("xy_{accel}.csv"));
+        Synth::new(Plane::Xy, ccw, accel).write_csv(&p);
+        files.push(p.to_str().unwrap().to_string());
+    }
+    let mut args = vec!["evaluate"];
+    args.extend(files.iter().map(String::as_str));
+    let r = eij(&args);
+    assert!(r.ok, "{}", r.stderr);
+    for f in &files {
+        assert!(r.stdout.contains(f.as_str()));
+    }
+    assert!(r.stdout.contains("EXY") && r.stdout.contains("rms residual"));
+    args.extend(["--pooled", "--json"]);
+    let r = eij(&args);
+    assert!(r.ok, "{}", r.stderr);
+    let v: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+    assert_eq!(v["tests"].as_array().unwrap().len(), 2);
+    let pooled = &v["pooled"];
+    assert_eq!(pooled["plane"], "xy");
+    assert_eq!(pooled["eij_um_s2_per_m"].as_object().unwrap().len(), 6);
+    assert_eq!(pooled["geometric_um_per_mm"].as_object().unwrap().len(), 6);
+    let _ = std::fs::remove_dir_all(&d);
+}
