@@ -23,6 +23,7 @@
 
 pub mod axes;
 pub mod control;
+pub mod ident;
 pub mod io;
 pub mod machine;
 pub mod mbs;

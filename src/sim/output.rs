@@ -10,6 +10,7 @@
 use super::Run;
 use crate::axes::Axis;
 use crate::control::ClosedLoop;
+use crate::rtest::{CircleSeries, RtestError};
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 
@@ -125,4 +126,18 @@ pub fn to_csv(cl: &ClosedLoop, run: &Run, opts: &CsvOptions) -> Vec<u8> {
         let _ = w.write_record(&record);
     }
     w.into_inner().unwrap_or_default()
+}
+
+/// The run as an in-memory R-Test series (internal = linear scales, external = TCP relative to
+/// the workpiece, mm), for evaluation without a CSV round trip.
+pub fn to_series(cl: &ClosedLoop, run: &Run, source: String) -> Result<CircleSeries, RtestError> {
+    let column = |name: String| -> Vec<f64> {
+        match cl.output(&name) {
+            Some(i) => run.output(i).map(|v| v * 1e3).collect(),
+            None => vec![0.0; run.len()],
+        }
+    };
+    let int_mm = Axis::ALL.map(|a| column(format!("{a}_int_m")));
+    let ext_mm = Axis::ALL.map(|a| column(format!("{a}_tcp_m")));
+    CircleSeries::new(source, run.t_s.clone(), int_mm, ext_mm)
 }

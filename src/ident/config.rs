@@ -1,0 +1,134 @@
+//! Identification settings from TOML (`--config FILE.toml`) and known-good regression files
+//! (`eij verify`).
+
+use super::measured::MeasuredOptions;
+use super::{IdentError, Method, Settings};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Optional settings; absent keys keep the defaults of [`Settings`] and [`MeasuredOptions`].
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IdentConfig {
+    /// Parameter names, e.g. `["x.guideway_normal", "z.screw"]`.
+    pub parameters: Option<Vec<String>>,
+    /// `lm` or `nelder-mead`.
+    pub method: Option<Method>,
+    /// Iteration limit.
+    pub max_iters: Option<u64>,
+    /// Lower bound of every factor.
+    pub min_factor: Option<f64>,
+    /// Upper bound of every factor.
+    pub max_factor: Option<f64>,
+    /// Output rate of the simulated tests, Hz.
+    pub rate_hz: Option<f64>,
+    /// Steady revolutions per simulated test.
+    pub revolutions: Option<u32>,
+    /// Radius of tests from EIJ tables, mm.
+    pub table_radius_mm: Option<f64>,
+    /// σ of table values without a standard error, µm·s²/m.
+    pub table_std_err_um_s2_per_m: Option<f64>,
+}
+
+impl IdentConfig {
+    /// Reads a config file.
+    pub fn from_file(path: &Path) -> Result<IdentConfig, IdentError> {
+        let name = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| IdentError::Test {
+            input: name.clone(),
+            message: format!("cannot read: {e}"),
+        })?;
+        toml::from_str(&text).map_err(|e| IdentError::Test {
+            input: name,
+            message: e.message().trim().replace('\n', " "),
+        })
+    }
+
+    /// Applies the present keys, validating them.
+    pub fn apply(&self, s: &mut Settings, m: &mut MeasuredOptions) -> Result<(), IdentError> {
+        let bad = |k: &str, v: String| IdentError::Test {
+            input: "settings".into(),
+            message: format!("{k} = {v} is not allowed"),
+        };
+        if let Some(v) = self.method {
+            s.method = v;
+        }
+        if let Some(v) = self.max_iters {
+            if v == 0 {
+                return Err(bad("max_iters", v.to_string()));
+            }
+            s.max_iters = v;
+        }
+        for (k, src, dst) in [
+            ("min_factor", self.min_factor, &mut s.min_factor),
+            ("max_factor", self.max_factor, &mut s.max_factor),
+            ("rate_hz", self.rate_hz, &mut s.rate_hz),
+            ("table_radius_mm", self.table_radius_mm, &mut m.table_radius_mm),
+            ("table_std_err_um_s2_per_m", self.table_std_err_um_s2_per_m, &mut m.table_std_err),
+        ] {
+            if let Some(v) = src {
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(bad(k, v.to_string()));
+                }
+                *dst = v;
+            }
+        }
+        if let Some(v) = self.revolutions {
+            if v == 0 {
+                return Err(bad("revolutions", v.to_string()));
+            }
+            s.revolutions = v;
+        }
+        if s.min_factor >= s.max_factor {
+            return Err(bad("min_factor", format!("{} (not below max_factor {})", s.min_factor, s.max_factor)));
+        }
+        Ok(())
+    }
+}
+
+/// An expected identified value with its tolerance.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Expected {
+    /// The known-good value.
+    pub value: f64,
+    /// Allowed relative deviation.
+    pub rel_tol: f64,
+}
+
+/// A stored identification whose result must not drift (`tests/known-good/*.toml`).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KnownGood {
+    /// What it checks.
+    pub description: String,
+    /// Machine file, relative to the known-good file.
+    pub machine: PathBuf,
+    /// Measured inputs, relative to the known-good file.
+    pub measured: Vec<PathBuf>,
+    /// Settings.
+    #[serde(default)]
+    pub settings: IdentConfig,
+    /// Expected factors by parameter name.
+    pub expected: BTreeMap<String, Expected>,
+}
+
+impl KnownGood {
+    /// Reads a known-good file and resolves its paths relative to it.
+    pub fn from_file(path: &Path) -> Result<KnownGood, IdentError> {
+        let name = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| IdentError::Test {
+            input: name.clone(),
+            message: format!("cannot read: {e}"),
+        })?;
+        let mut k: KnownGood = toml::from_str(&text).map_err(|e| IdentError::Test {
+            input: name,
+            message: e.message().trim().replace('\n', " "),
+        })?;
+        let dir = path.parent().unwrap_or(Path::new("."));
+        k.machine = dir.join(&k.machine);
+        k.measured = k.measured.iter().map(|m| dir.join(m)).collect();
+        Ok(k)
+    }
+}

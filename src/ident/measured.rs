@@ -1,0 +1,112 @@
+//! Measured EIJ for identification, from R-Test CSV files (through the evaluation), folders of
+//! them, or EIJ tables (CONTRACT.md).
+
+use super::{IdentError, TestCase};
+use crate::rtest::{self, table, CircleSeries, EvalOptions};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// How to read measured data.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeasuredOptions {
+    /// Circle radius of EIJ-table tests (tables carry no radius), mm.
+    pub table_radius_mm: f64,
+    /// σ for table values without a standard error, µm·s²/m.
+    pub table_std_err: f64,
+}
+
+impl Default for MeasuredOptions {
+    fn default() -> Self {
+        MeasuredOptions {
+            table_radius_mm: 2.0,
+            table_std_err: 0.05,
+        }
+    }
+}
+
+/// Whether a CSV file is an EIJ table (has a `parameter` column) rather than a time series.
+fn is_table(path: &Path) -> bool {
+    std::fs::read(path)
+        .ok()
+        .and_then(|b| {
+            let first = b.split(|&c| c == b'\n').next()?.to_vec();
+            Some(String::from_utf8_lossy(&first).split(',').any(|c| c.trim() == "parameter"))
+        })
+        .unwrap_or(false)
+}
+
+/// Expands folders (their `*.csv`, sorted) and keeps files.
+pub fn expand(paths: &[PathBuf]) -> Result<Vec<PathBuf>, IdentError> {
+    let mut files = Vec::new();
+    for p in paths {
+        if p.is_dir() {
+            let mut inside: Vec<PathBuf> = std::fs::read_dir(p)
+                .map_err(|e| IdentError::Test {
+                    input: p.display().to_string(),
+                    message: format!("cannot read folder: {e}"),
+                })?
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|f| f.is_file() && f.extension().is_some_and(|x| x.eq_ignore_ascii_case("csv")))
+                .collect();
+            inside.sort();
+            if inside.is_empty() {
+                return Err(IdentError::Test {
+                    input: p.display().to_string(),
+                    message: "folder holds no .csv files".into(),
+                });
+            }
+            files.extend(inside);
+        } else {
+            files.push(p.clone());
+        }
+    }
+    Ok(files)
+}
+
+/// Reads every path into test cases (R-Test series are evaluated; tables grouped by plane,
+/// direction and acceleration).
+pub fn load(paths: &[PathBuf], opts: &MeasuredOptions) -> Result<Vec<TestCase>, IdentError> {
+    let files = expand(paths)?;
+    let mut tests = Vec::new();
+    for f in &files {
+        let name = f.display().to_string();
+        let err = |e: rtest::RtestError| IdentError::Test {
+            input: name.clone(),
+            message: e.to_string(),
+        };
+        if is_table(f) {
+            let rows = table::read(f).map_err(err)?;
+            let mut groups: BTreeMap<(String, String, u64), TestCase> = BTreeMap::new();
+            for row in rows {
+                let key = (row.plane.to_string(), row.direction.to_string(), row.accel_m_s2.to_bits());
+                let case = groups.entry(key).or_insert_with(|| TestCase {
+                    source: format!("{name} ({} {} {} m/s²)", row.plane, row.direction, row.accel_m_s2),
+                    plane: row.plane,
+                    direction: row.direction,
+                    radius_mm: opts.table_radius_mm,
+                    accel_m_s2: row.accel_m_s2,
+                    measured: BTreeMap::new(),
+                });
+                case.measured
+                    .insert(row.parameter, (row.value, row.std_err.unwrap_or(opts.table_std_err)));
+            }
+            tests.extend(groups.into_values());
+        } else {
+            let series = CircleSeries::read_csv(f).map_err(err)?;
+            let result = rtest::evaluate(&series, &EvalOptions::default()).map_err(err)?;
+            tests.push(TestCase {
+                source: name.clone(),
+                plane: result.plane,
+                direction: result.direction,
+                radius_mm: result.radius_mm,
+                accel_m_s2: result.accel_m_s2,
+                measured: result
+                    .eij
+                    .iter()
+                    .map(|(p, v)| (*p, (*v, result.std_err[p])))
+                    .collect(),
+            });
+        }
+    }
+    Ok(tests)
+}
