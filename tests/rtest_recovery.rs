@@ -196,3 +196,20 @@ fn bad_set_radius_is_refused() {
         assert!(err.contains("must be a positive number of mm"), "{err}");
     }
 }
+
+/// Long dwells at rest (the plateau is only 7 % of the file) do not hide the plateau: still 5
+/// whole revolutions, still exact.
+#[test]
+fn long_dwells_still_give_the_plateau() {
+    let mut syn = Synth::new(Plane::Yz, false, 10.0).exact();
+    syn.dwell_s = 3.0;
+    let r = evaluate(&syn.series(), &EvalOptions::default()).unwrap();
+    assert_eq!(r.revolutions, 5);
+    for (p, truth) in syn.truth() {
+        assert!(
+            (r.eij[&p] - truth).abs() < 1e-9,
+            "{p}: {} vs {truth}",
+            r.eij[&p]
+        );
+    }
+}

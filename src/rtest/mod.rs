@@ -6,6 +6,26 @@
 //!                                                       └─► ellipse fit (paper, in-talk)
 //! several series of one plane ─► pooled (separates static geometry from EIJ)
 //! ```
+//!
+//! ```no_run
+//! use eij::rtest::{evaluate, evaluate_pooled, CircleSeries, EvalOptions};
+//!
+//! # fn main() -> Result<(), eij::rtest::RtestError> {
+//! let opts = EvalOptions { radius_mm: Some(2.0), ..Default::default() };
+//! let slow = CircleSeries::read_csv("measurements/zx_ccw_2.csv")?;
+//! let fast = CircleSeries::read_csv("measurements/zx_ccw_10.csv")?;
+//! let result = evaluate(&fast, &opts)?;
+//! println!("{} {} {:?}", result.plane, result.direction, result.eij);
+//! let pooled = evaluate_pooled(&[&slow, &fast], &opts)?;
+//! println!("{:?} {:?}", pooled.eij, pooled.geometric_um_per_mm);
+//! # Ok(())
+//! # }
+//! ```
+//!
+//! What counts as steady: the local angular speed (phase differences over 1/8 revolution)
+//! within 0.5 % of the plateau speed; of the longest such run only whole revolutions are kept,
+//! centred. With slow ramps this band includes the last ~5 % of each ramp's duration, where the
+//! acceleration is up to 1 % below the plateau's.
 
 use std::collections::BTreeMap;
 
