@@ -396,7 +396,7 @@ fn steady_revolutions(
     };
     if total.abs() < TAU {
         return Err(too_short(format!(
-            "only {:.2} revolution(s) in all, at least one whole steady revolution needed",
+            "only {:.3} revolution(s) in all, at least one whole steady revolution needed",
             total.abs() / TAU
         )));
     }
@@ -420,6 +420,9 @@ fn steady_revolutions(
         }
         speed = local_speed(h);
         let top = speed.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        if top.is_nan() || top <= 0.0 {
+            return Err(too_short("no steady rotation found".into()));
+        }
         scratch = speed.iter().copied().filter(|&w| w >= 0.5 * top).collect();
         reference = percentile_90(&mut scratch);
         if reference <= 0.0 {
@@ -443,8 +446,8 @@ fn steady_revolutions(
     let revolutions = (span / TAU + 1e-9).floor();
     if revolutions < 1.0 {
         return Err(too_short(format!(
-            "only {:.2} steady revolution(s), at least one whole steady revolution needed",
-            span / TAU
+            "only {:.3} steady revolution(s), at least one whole steady revolution needed",
+            span.max(0.0) / TAU
         )));
     }
     let slack = span - revolutions * TAU;
