@@ -22,7 +22,7 @@
 //! # }
 //! ```
 //!
-//! What counts as steady: the local angular speed (phase differences over 1/8 revolution)
+//! What counts as steady: the local angular speed (phase differences over 1/4 revolution)
 //! within 0.5 % of the plateau speed; of the longest such run only whole revolutions are kept,
 //! centred. With slow ramps this band includes the last ~5 % of each ramp's duration, where the
 //! acceleration is up to 1 % below the plateau's.
