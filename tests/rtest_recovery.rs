@@ -50,6 +50,7 @@ fn noise_free_recovery_is_exact() {
 #[test]
 fn noisy_recovery_within_three_standard_errors() {
     let mut z2 = Vec::new();
+    let mut z2_ellipse = Vec::new();
     for plane in Plane::ALL {
         for ccw in [false, true] {
             for (k, accel) in ACCELS.into_iter().enumerate() {
@@ -82,9 +83,20 @@ fn noisy_recovery_within_three_standard_errors() {
                     r.rms_residual_um
                 );
                 assert!(r.warnings.is_empty(), "{:?}", r.warnings);
+                let route = r.ellipse_fit.as_ref().unwrap();
+                for (p, v) in &route.eij {
+                    let z = (v - route.predicted_from_joint[p]) / r.std_err[p];
+                    z2_ellipse.push(z * z);
+                }
             }
         }
     }
+    let m_e = z2_ellipse.len() as f64;
+    let mean_e = z2_ellipse.iter().sum::<f64>() / m_e;
+    println!("ellipse route vs prediction: mean z² = {mean_e} over {m_e}");
+    // The route shares the data with the joint fit: its difference from the prediction is no
+    // noisier than one joint standard error, so the 3·√2·se warning threshold is conservative.
+    assert!(mean_e < 1.0, "ellipse route mean z² = {mean_e}");
     let m = z2.len() as f64;
     let mean_z2 = z2.iter().sum::<f64>() / m;
     // E[z²] = 1 with standard deviation √(2/m) for honest standard errors.
@@ -233,5 +245,23 @@ fn noisy_internal_readings_are_tolerated() {
                 r.std_err[&p]
             );
         }
+    }
+}
+
+/// Noise-free but with an elliptic internal path (axis radius errors +3/−2 µm): the ellipse
+/// route equals the same route applied to the joint fit's model; the first-order truncation
+/// (here up to ~E·ε ≈ 0.03 µm·s²/m) cancels.
+#[test]
+fn ellipse_route_matches_its_joint_prediction() {
+    for plane in Plane::ALL {
+        let mut syn = Synth::new(plane, true, 10.0);
+        syn.noise_um = 0.0;
+        let r = evaluate(&syn.series(), &EvalOptions::default()).unwrap();
+        let route = r.ellipse_fit.as_ref().unwrap();
+        for (p, v) in &route.eij {
+            let pred = route.predicted_from_joint[p];
+            assert!((v - pred).abs() < 1e-6, "{p}: {v} vs {pred}");
+        }
+        assert!(r.warnings.is_empty(), "{:?}", r.warnings);
     }
 }
