@@ -218,3 +218,77 @@ fn byte_order_mark_crlf_and_blank_lines() {
     );
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// No input panics: random and degenerate in-memory series (jumps, points at the centre,
+/// reversals, tiny and huge values) evaluate to a result or an error.
+#[test]
+fn random_series_never_panic() {
+    let mut rng = rtest_common::Rng::new(42);
+    let (mut evaluated, mut succeeded) = (0, 0);
+    for case in 0..400 {
+        let n = 2 + (rng.gauss().abs() * 1500.0) as usize;
+        let step = [0.05, 0.2, 0.01][case % 3];
+        let scale = [1e-9, 1e-3, 1.0, 2.0, 40.0, 1e6][case % 6];
+        let mut t = Vec::with_capacity(n);
+        let mut acc = 0.0;
+        for _ in 0..n {
+            acc += 1e-3
+                * if case % 5 == 0 {
+                    1.0 + rng.gauss().abs()
+                } else {
+                    1.0
+                };
+            t.push(acc);
+        }
+        let mut col = |circle: bool, sin: bool| -> Vec<f64> {
+            (0..n)
+                .map(|i| {
+                    let ph = i as f64 * step * if case % 4 == 0 { -1.0 } else { 1.0 };
+                    let base = if !circle {
+                        0.0
+                    } else if sin {
+                        2.0 * ph.sin()
+                    } else {
+                        2.0 * ph.cos()
+                    };
+                    let jump = if case % 7 == 0 && i == n / 2 {
+                        5.0
+                    } else {
+                        0.0
+                    };
+                    base + jump + scale * 1e-5 * rng.gauss()
+                })
+                .collect()
+        };
+        let circle = case % 3 != 0;
+        let int = [col(circle, false), col(circle, true), col(false, false)];
+        let ext = [
+            int[0].iter().map(|v| v + 1e-3 * rng.gauss()).collect(),
+            int[1].clone(),
+            int[2].iter().map(|v| v + scale * 1e-4).collect(),
+        ];
+        if let Ok(s) = CircleSeries::new(format!("case {case}"), t, int, ext) {
+            evaluated += 1;
+            for opts in [
+                EvalOptions::default(),
+                EvalOptions {
+                    plane: Some(Plane::Zx),
+                    radius_mm: Some(2.0),
+                },
+            ] {
+                match evaluate(&s, &opts) {
+                    Ok(_) => succeeded += 1,
+                    Err(e) => {
+                        assert!(e.to_string().starts_with(&format!("case {case}")), "{e}")
+                    }
+                }
+            }
+            let _ = eij::rtest::evaluate_pooled(&[&s, &s], &EvalOptions::default());
+        }
+    }
+    // The cases reach the fits, not only the input checks.
+    assert!(
+        evaluated > 300 && succeeded >= 20,
+        "{evaluated} {succeeded}"
+    );
+}

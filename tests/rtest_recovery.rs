@@ -50,6 +50,7 @@ fn noise_free_recovery_is_exact() {
 #[test]
 fn noisy_recovery_within_three_standard_errors() {
     let mut z2 = Vec::new();
+    let mut z2_ellipse = Vec::new();
     for plane in Plane::ALL {
         for ccw in [false, true] {
             for (k, accel) in ACCELS.into_iter().enumerate() {
@@ -82,9 +83,20 @@ fn noisy_recovery_within_three_standard_errors() {
                     r.rms_residual_um
                 );
                 assert!(r.warnings.is_empty(), "{:?}", r.warnings);
+                let route = r.ellipse_fit.as_ref().unwrap();
+                for (p, v) in &route.eij {
+                    let z = (v - route.predicted_from_joint[p]) / r.std_err[p];
+                    z2_ellipse.push(z * z);
+                }
             }
         }
     }
+    let m_e = z2_ellipse.len() as f64;
+    let mean_e = z2_ellipse.iter().sum::<f64>() / m_e;
+    println!("ellipse route vs prediction: mean z² = {mean_e} over {m_e}");
+    // The route shares the data with the joint fit: its difference from the prediction is no
+    // noisier than one joint standard error, so the 3·√2·se warning threshold is conservative.
+    assert!(mean_e < 1.0, "ellipse route mean z² = {mean_e}");
     let m = z2.len() as f64;
     let mean_z2 = z2.iter().sum::<f64>() / m;
     // E[z²] = 1 with standard deviation √(2/m) for honest standard errors.
@@ -194,5 +206,62 @@ fn bad_set_radius_is_refused() {
         };
         let err = evaluate(&s, &opts).unwrap_err().to_string();
         assert!(err.contains("must be a positive number of mm"), "{err}");
+    }
+}
+
+/// Long dwells at rest (the plateau is only 7 % of the file) do not hide the plateau: still 5
+/// whole revolutions, still exact.
+#[test]
+fn long_dwells_still_give_the_plateau() {
+    let mut syn = Synth::new(Plane::Yz, false, 10.0).exact();
+    syn.dwell_s = 3.0;
+    let r = evaluate(&syn.series(), &EvalOptions::default()).unwrap();
+    assert_eq!(r.revolutions, 5);
+    for (p, truth) in syn.truth() {
+        assert!(
+            (r.eij[&p] - truth).abs() < 1e-9,
+            "{p}: {} vs {truth}",
+            r.eij[&p]
+        );
+    }
+}
+
+/// Noisy internal readings (1 µm, far noisier than linear scales) still give the steady
+/// revolutions, and the EIJ within 3 standard errors.
+#[test]
+fn noisy_internal_readings_are_tolerated() {
+    for plane in Plane::ALL {
+        let mut syn = Synth::new(plane, false, 4.0);
+        syn.int_noise_um = 1.0;
+        syn.seed = 5 + plane as u64;
+        let r = evaluate(&syn.series(), &EvalOptions::default()).unwrap();
+        assert_eq!(r.revolutions, 5);
+        for (p, truth) in syn.truth() {
+            let z = (r.eij[&p] - truth) / r.std_err[&p];
+            assert!(
+                z.abs() < 3.0,
+                "{plane} {p}: {} ± {}",
+                r.eij[&p],
+                r.std_err[&p]
+            );
+        }
+    }
+}
+
+/// Noise-free but with an elliptic internal path (axis radius errors +3/−2 µm): the ellipse
+/// route equals the same route applied to the joint fit's model; the first-order truncation
+/// (here up to ~E·ε ≈ 0.03 µm·s²/m) cancels.
+#[test]
+fn ellipse_route_matches_its_joint_prediction() {
+    for plane in Plane::ALL {
+        let mut syn = Synth::new(plane, true, 10.0);
+        syn.noise_um = 0.0;
+        let r = evaluate(&syn.series(), &EvalOptions::default()).unwrap();
+        let route = r.ellipse_fit.as_ref().unwrap();
+        for (p, v) in &route.eij {
+            let pred = route.predicted_from_joint[p];
+            assert!((v - pred).abs() < 1e-6, "{p}: {v} vs {pred}");
+        }
+        assert!(r.warnings.is_empty(), "{:?}", r.warnings);
     }
 }

@@ -208,6 +208,9 @@ pub struct EllipseRoute {
     pub half_width_int_mm: [f64; 2],
     /// Half-widths (a, b) of the external path, mm.
     pub half_width_ext_mm: [f64; 2],
+    /// The same route applied to the joint fit's noise-free model of the external path
+    /// (internal readings + in-plane E·ä), see [`predict_ellipse_route`]; empty until filled.
+    pub predicted_from_joint: BTreeMap<Eij, f64>,
 }
 
 /// Fits both ellipses over the steady revolutions and converts them to in-talk.
@@ -230,5 +233,30 @@ pub fn ellipse_route(
         eij,
         half_width_int_mm: int.map(|w| w * r),
         half_width_ext_mm: ext.map(|w| w * r),
+        predicted_from_joint: BTreeMap::new(),
     })
+}
+
+/// What the ellipse route would return if the external path were exactly the joint fit's
+/// model: x_ext = x_int + (E_p ä)/1000 mm with the in-plane 2×2 block E_p of `eij`. The route's
+/// own nonlinearity (second order in ε, the internal path's ellipticity) is then the same for
+/// both, so the measured route differs from this prediction by noise only.
+pub fn predict_ellipse_route(
+    norm: &Normalised,
+    int_mm: [&[f64]; 2],
+    eij: &BTreeMap<Eij, f64>,
+) -> Option<BTreeMap<Eij, f64>> {
+    let (a, b) = norm.plane.axes();
+    let e = |i: Axis, j: Axis| eij.get(&Eij::new(i, j)).copied();
+    let (eaa, eab, eba, ebb) = (e(a, a)?, e(a, b)?, e(b, a)?, e(b, b)?);
+    let [acc_a, acc_b] = &norm.acc_m_s2;
+    let model = |k: usize, ea: f64, eb: f64| -> Vec<f64> {
+        int_mm[k]
+            .iter()
+            .zip(acc_a.iter().zip(acc_b))
+            .map(|(x, (aa, ab))| x + (ea * aa + eb * ab) * 1e-3)
+            .collect()
+    };
+    let (pa, pb) = (model(0, eaa, eab), model(1, eba, ebb));
+    Some(ellipse_route(norm, int_mm, [&pa, &pb])?.eij)
 }

@@ -376,9 +376,10 @@ fn slope(t: &[f64], y: &[f64]) -> f64 {
 
 /// Finds the steady part and keeps only whole revolutions of it.
 ///
-/// The local angular speed is the phase difference over a window of about 1/8 revolution
-/// (`±h` samples). The plateau speed is first taken as the 90th percentile of it and refined as
-/// the median over the plateau; the plateau is the longest run within [`STEADY_TOLERANCE`] of
+/// The local angular speed is the phase difference over a window of about 1/4 revolution
+/// (`±h` samples). The plateau speed is first taken as the 90th percentile of the speeds above
+/// half the largest one (dwells and slow ramp parts do not count) and refined as the median
+/// over the plateau; the plateau is the longest run within [`STEADY_TOLERANCE`] of
 /// that speed. Of it the largest whole number of revolutions is kept, centred, so that the
 /// ramp-in and ramp-out are trimmed alike. Returns `(first, end, revolutions)`.
 fn steady_revolutions(
@@ -395,28 +396,48 @@ fn steady_revolutions(
     };
     if total.abs() < TAU {
         return Err(too_short(format!(
-            "only {:.2} revolution(s) in all, at least one whole steady revolution needed",
+            "only {:.3} revolution(s) in all, at least one whole steady revolution needed",
             total.abs() / TAU
         )));
     }
-    let samples_per_rev = n as f64 * TAU / total.abs();
-    let h = ((samples_per_rev / 16.0) as usize).max(1);
-    if n < 2 * h + 3 {
-        return Err(too_short(format!("only {n} samples")));
-    }
-    let speed: Vec<f64> = (h..n - h)
-        .map(|k| sign * (phase[k + h] - phase[k - h]) / (t[k + h] - t[k - h]))
-        .collect();
-    let mut scratch = speed.clone();
-    let q90 = (scratch.len() * 9) / 10;
-    let (_, reference, _) = scratch.select_nth_unstable_by(q90, f64::total_cmp);
-    let reference = *reference;
-    if reference <= 0.0 {
-        return Err(too_short("no steady rotation found".into()));
+    let local_speed = |h: usize| -> Vec<f64> {
+        (h..n - h)
+            .map(|k| sign * (phase[k + h] - phase[k - h]) / (t[k + h] - t[k - h]))
+            .collect()
+    };
+    let percentile_90 = |v: &mut [f64]| -> f64 {
+        let q = (v.len() * 9) / 10;
+        *v.select_nth_unstable_by(q, f64::total_cmp).1
+    };
+    // The mean speed over the whole file underestimates the plateau speed (dwells, ramps), so
+    // the first window is too wide; it is narrowed to 1/4 of a plateau revolution once.
+    let mean_dt = (t[n - 1] - t[0]) / (n - 1) as f64;
+    let mut h = ((n as f64 * TAU / total.abs() / 8.0) as usize).max(1);
+    let (mut speed, mut scratch, mut reference): (Vec<f64>, Vec<f64>, f64);
+    loop {
+        if n < 2 * h + 3 {
+            return Err(too_short(format!("only {n} samples")));
+        }
+        speed = local_speed(h);
+        let top = speed.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        if top.is_nan() || top <= 0.0 {
+            return Err(too_short("no steady rotation found".into()));
+        }
+        scratch = speed.iter().copied().filter(|&w| w >= 0.5 * top).collect();
+        reference = percentile_90(&mut scratch);
+        if reference <= 0.0 {
+            return Err(too_short("no steady rotation found".into()));
+        }
+        let h_plateau = ((TAU / (reference * mean_dt) / 8.0) as usize).max(1);
+        if 2 * h_plateau >= h {
+            break;
+        }
+        h = h_plateau;
     }
     let (mut k0, mut k1) = longest_run(&speed, reference);
-    let run = &mut scratch[..=k1 - k0];
-    run.copy_from_slice(&speed[k0..=k1]);
+    scratch.clear();
+    scratch.extend_from_slice(&speed[k0..=k1]);
+    let run = scratch.as_mut_slice();
     let mid = run.len() / 2;
     let (_, median, _) = run.select_nth_unstable_by(mid, f64::total_cmp);
     (k0, k1) = longest_run(&speed, *median);
@@ -425,8 +446,8 @@ fn steady_revolutions(
     let revolutions = (span / TAU + 1e-9).floor();
     if revolutions < 1.0 {
         return Err(too_short(format!(
-            "only {:.2} steady revolution(s), at least one whole steady revolution needed",
-            span / TAU
+            "only {:.3} steady revolution(s), at least one whole steady revolution needed",
+            span.max(0.0) / TAU
         )));
     }
     let slack = span - revolutions * TAU;

@@ -12,6 +12,7 @@
 //! * external = internal + (E·ä + G·x_set + offsets + Gaussian noise σ) / 1000 (µm → mm), with
 //!   E the 3×2 EIJ of the plane (rows a, b, k; columns a, b) and G static geometric terms
 //!   (µm per mm of set position);
+//! * optional reading noise on the internal readings (`int_noise_um`);
 //! * noise: xorshift64* + Box–Muller, deterministic from `seed`.
 #![allow(dead_code)]
 
@@ -44,6 +45,9 @@ pub struct Synth {
     /// Static geometric terms, µm/mm: rows deviation a, b, k; columns set position a, b.
     pub g_um_per_mm: [[f64; 2]; 3],
     pub noise_um: f64,
+    /// Reading noise of the internal measuring systems, µm (the external reading stays
+    /// internal position + deviation: d = ext − int then carries this noise too).
+    pub int_noise_um: f64,
     pub seed: u64,
 }
 
@@ -67,6 +71,7 @@ impl Synth {
             e: [[2.5, -0.8], [0.6, 1.7], [-1.55, 0.9]],
             g_um_per_mm: [[0.0; 2]; 3],
             noise_um: 1.4,
+            int_noise_um: 0.0,
             seed: 0x9E37_79B9_7F4A_7C15,
         }
     }
@@ -153,7 +158,12 @@ impl Synth {
             }
             t_s.push(t);
             for i in 0..3 {
-                int[idx[i]].push(pi[i]);
+                let reading_noise = if self.int_noise_um > 0.0 {
+                    self.int_noise_um * 1e-3 * rng.gauss()
+                } else {
+                    0.0
+                };
+                int[idx[i]].push(pi[i] + reading_noise);
                 ext[idx[i]].push(pe[i]);
             }
         }
@@ -219,7 +229,7 @@ impl Rng {
         Rng(seed.max(1))
     }
 
-    fn next_u64(&mut self) -> u64 {
+    pub fn next_u64(&mut self) -> u64 {
         let mut x = self.0;
         x ^= x >> 12;
         x ^= x << 25;
