@@ -14,7 +14,8 @@ use std::hint::black_box;
 use std::path::Path;
 
 fn demo() -> Machine {
-    Machine::from_file(&Path::new(env!("CARGO_MANIFEST_DIR")).join("machines/demo-vmc.toml")).unwrap()
+    Machine::from_file(&Path::new(env!("CARGO_MANIFEST_DIR")).join("machines/demo-vmc.toml"))
+        .unwrap()
 }
 
 fn bench(c: &mut Criterion) {
@@ -24,10 +25,13 @@ fn bench(c: &mut Criterion) {
         b.iter(|| Model::assemble(black_box(&machine), black_box(&pose)).unwrap())
     });
     let model = Model::assemble(&machine, &pose).unwrap();
-    c.bench_function("modal analysis (demo)", |b| b.iter(|| modal::modes(black_box(&model)).unwrap()));
-    c.bench_function("closed loop with support and stability checks (demo)", |b| {
-        b.iter(|| ClosedLoop::new(black_box(&machine), black_box(&pose)).unwrap())
+    c.bench_function("modal analysis (demo)", |b| {
+        b.iter(|| modal::modes(black_box(&model)).unwrap())
     });
+    c.bench_function(
+        "closed loop with support and stability checks (demo)",
+        |b| b.iter(|| ClosedLoop::new(black_box(&machine), black_box(&pose)).unwrap()),
+    );
     let cl = ClosedLoop::new(&machine, &pose).unwrap();
     c.bench_function("discretise, first-order hold, 10 kHz (demo)", |b| {
         b.iter(|| Discrete::new(black_box(&cl), 1e-4))
@@ -35,9 +39,14 @@ fn bench(c: &mut Criterion) {
     let disc = Discrete::new(&cl, 1e-4);
     let mut circle = Circle::new(Plane::Zx, 0.002, 5.0, Direction::Ccw);
     circle.steady_revolutions = 3;
-    c.bench_function("circle zx 5 m/s², 3 revolutions + ramps, 10 kHz (demo)", |b| {
-        b.iter(|| simulate_discrete(black_box(&cl), black_box(&disc), black_box(&circle)).unwrap())
-    });
+    c.bench_function(
+        "circle zx 5 m/s², 3 revolutions + ramps, 10 kHz (demo)",
+        |b| {
+            b.iter(|| {
+                simulate_discrete(black_box(&cl), black_box(&disc), black_box(&circle)).unwrap()
+            })
+        },
+    );
 }
 
 criterion_group!(benches, bench);

@@ -25,8 +25,8 @@ pub struct IdentConfig {
     pub rate_hz: Option<f64>,
     /// Steady revolutions per simulated test.
     pub revolutions: Option<u32>,
-    /// Radius of tests from EIJ tables, mm.
-    pub table_radius_mm: Option<f64>,
+    /// Set radius of the circle tests, mm (2).
+    pub radius_mm: Option<f64>,
     /// σ of table values without a standard error, µm·s²/m.
     pub table_std_err_um_s2_per_m: Option<f64>,
 }
@@ -64,8 +64,12 @@ impl IdentConfig {
             ("min_factor", self.min_factor, &mut s.min_factor),
             ("max_factor", self.max_factor, &mut s.max_factor),
             ("rate_hz", self.rate_hz, &mut s.rate_hz),
-            ("table_radius_mm", self.table_radius_mm, &mut m.table_radius_mm),
-            ("table_std_err_um_s2_per_m", self.table_std_err_um_s2_per_m, &mut m.table_std_err),
+            ("radius_mm", self.radius_mm, &mut m.radius_mm),
+            (
+                "table_std_err_um_s2_per_m",
+                self.table_std_err_um_s2_per_m,
+                &mut m.table_std_err,
+            ),
         ] {
             if let Some(v) = src {
                 if !(v.is_finite() && v > 0.0) {
@@ -81,7 +85,10 @@ impl IdentConfig {
             s.revolutions = v;
         }
         if s.min_factor >= s.max_factor {
-            return Err(bad("min_factor", format!("{} (not below max_factor {})", s.min_factor, s.max_factor)));
+            return Err(bad(
+                "min_factor",
+                format!("{} (not below max_factor {})", s.min_factor, s.max_factor),
+            ));
         }
         Ok(())
     }

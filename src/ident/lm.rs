@@ -7,7 +7,8 @@
 //! below `tol_cost`, or when the step falls below `tol_step`.
 
 use argmin::core::{
-    Error, IterState, Jacobian, Operator, Problem, Solver, State, TerminationReason, TerminationStatus, KV,
+    Error, IterState, Jacobian, Operator, Problem, Solver, State, TerminationReason,
+    TerminationStatus, KV,
 };
 use nalgebra::{DMatrix, DVector};
 
@@ -39,7 +40,9 @@ impl LevenbergMarquardt {
     }
 
     fn clamp(&self, theta: &DVector<f64>) -> DVector<f64> {
-        DVector::from_fn(theta.len(), |i, _| theta[i].clamp(self.lower[i], self.upper[i]))
+        DVector::from_fn(theta.len(), |i, _| {
+            theta[i].clamp(self.lower[i], self.upper[i])
+        })
     }
 }
 
@@ -56,17 +59,25 @@ where
         "Levenberg-Marquardt"
     }
 
-    fn init(&mut self, problem: &mut Problem<O>, mut state: LmState) -> Result<(LmState, Option<KV>), Error> {
-        let theta = state
-            .take_param()
-            .ok_or_else(|| anyhow::anyhow!("Levenberg-Marquardt needs an initial parameter vector"))?;
+    fn init(
+        &mut self,
+        problem: &mut Problem<O>,
+        mut state: LmState,
+    ) -> Result<(LmState, Option<KV>), Error> {
+        let theta = state.take_param().ok_or_else(|| {
+            anyhow::anyhow!("Levenberg-Marquardt needs an initial parameter vector")
+        })?;
         let theta = self.clamp(&theta);
         let r = problem.apply(&theta)?;
         let cost = half_sq(&r);
         Ok((state.param(theta).residuals(r).cost(cost), None))
     }
 
-    fn next_iter(&mut self, problem: &mut Problem<O>, state: LmState) -> Result<(LmState, Option<KV>), Error> {
+    fn next_iter(
+        &mut self,
+        problem: &mut Problem<O>,
+        state: LmState,
+    ) -> Result<(LmState, Option<KV>), Error> {
         let theta = state
             .get_param()
             .ok_or_else(|| anyhow::anyhow!("Levenberg-Marquardt: no parameter"))?
@@ -103,7 +114,10 @@ where
                     self.converged = true;
                 }
                 let kv = argmin::kv!("lambda" => self.lambda; "step" => step;);
-                return Ok((state.param(trial).residuals(r_new).cost(c_new).jacobian(j), Some(kv)));
+                return Ok((
+                    state.param(trial).residuals(r_new).cost(c_new).jacobian(j),
+                    Some(kv),
+                ));
             }
             self.lambda *= 4.0;
         }
@@ -136,7 +150,9 @@ mod tests {
         type Param = DVector<f64>;
         type Output = DVector<f64>;
         fn apply(&self, p: &DVector<f64>) -> Result<DVector<f64>, Error> {
-            Ok(DVector::from_fn(self.t.len(), |i, _| p[0] * (-p[1] * self.t[i]).exp() - self.y[i]))
+            Ok(DVector::from_fn(self.t.len(), |i, _| {
+                p[0] * (-p[1] * self.t[i]).exp() - self.y[i]
+            }))
         }
     }
 
@@ -160,18 +176,31 @@ mod tests {
         let t: Vec<f64> = (0..20).map(|i| i as f64 * 0.25).collect();
         let y = t.iter().map(|t| 2.0 * (-0.7 * t).exp()).collect();
         let problem = Decay { t, y };
-        let lm = LevenbergMarquardt::new(DVector::from_vec(vec![0.0, 0.0]), DVector::from_vec(vec![10.0, 10.0]), 1e-15, 1e-12);
+        let lm = LevenbergMarquardt::new(
+            DVector::from_vec(vec![0.0, 0.0]),
+            DVector::from_vec(vec![10.0, 10.0]),
+            1e-15,
+            1e-12,
+        );
         let res = Executor::new(problem, lm)
             .configure(|s| s.param(DVector::from_vec(vec![1.0, 2.0])).max_iters(100))
             .run()
             .unwrap();
         let p = res.state().get_best_param().unwrap();
-        assert!((p[0] - 2.0).abs() < 1e-8 && (p[1] - 0.7).abs() < 1e-8, "{p}");
+        assert!(
+            (p[0] - 2.0).abs() < 1e-8 && (p[1] - 0.7).abs() < 1e-8,
+            "{p}"
+        );
 
         // With b bounded to ≤ 0.5 the solution sits on the bound.
         let t: Vec<f64> = (0..20).map(|i| i as f64 * 0.25).collect();
         let y = t.iter().map(|t| 2.0 * (-0.7 * t).exp()).collect();
-        let lm = LevenbergMarquardt::new(DVector::from_vec(vec![0.0, 0.0]), DVector::from_vec(vec![10.0, 0.5]), 1e-15, 1e-12);
+        let lm = LevenbergMarquardt::new(
+            DVector::from_vec(vec![0.0, 0.0]),
+            DVector::from_vec(vec![10.0, 0.5]),
+            1e-15,
+            1e-12,
+        );
         let res = Executor::new(Decay { t, y }, lm)
             .configure(|s| s.param(DVector::from_vec(vec![1.0, 0.1])).max_iters(100))
             .run()

@@ -9,8 +9,10 @@ use std::path::{Path, PathBuf};
 /// How to read measured data.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MeasuredOptions {
-    /// Circle radius of EIJ-table tests (tables carry no radius), mm.
-    pub table_radius_mm: f64,
+    /// Set radius of the circle tests, mm: R-Test series are evaluated with it, table tests
+    /// (tables carry no radius) take it, and the simulated tests run and are evaluated with it,
+    /// so that measurement and model are compared like with like.
+    pub radius_mm: f64,
     /// σ for table values without a standard error, µm·s²/m.
     pub table_std_err: f64,
 }
@@ -18,7 +20,7 @@ pub struct MeasuredOptions {
 impl Default for MeasuredOptions {
     fn default() -> Self {
         MeasuredOptions {
-            table_radius_mm: 2.0,
+            radius_mm: 2.0,
             table_std_err: 0.05,
         }
     }
@@ -30,7 +32,11 @@ fn is_table(path: &Path) -> bool {
         .ok()
         .and_then(|b| {
             let first = b.split(|&c| c == b'\n').next()?.to_vec();
-            Some(String::from_utf8_lossy(&first).split(',').any(|c| c.trim() == "parameter"))
+            Some(
+                String::from_utf8_lossy(&first)
+                    .split(',')
+                    .any(|c| c.trim() == "parameter"),
+            )
         })
         .unwrap_or(false)
 }
@@ -46,7 +52,9 @@ pub fn expand(paths: &[PathBuf]) -> Result<Vec<PathBuf>, IdentError> {
                     message: format!("cannot read folder: {e}"),
                 })?
                 .filter_map(|e| e.ok().map(|e| e.path()))
-                .filter(|f| f.is_file() && f.extension().is_some_and(|x| x.eq_ignore_ascii_case("csv")))
+                .filter(|f| {
+                    f.is_file() && f.extension().is_some_and(|x| x.eq_ignore_ascii_case("csv"))
+                })
                 .collect();
             inside.sort();
             if inside.is_empty() {
@@ -78,22 +86,35 @@ pub fn load(paths: &[PathBuf], opts: &MeasuredOptions) -> Result<Vec<TestCase>, 
             let rows = table::read(f).map_err(err)?;
             let mut groups: BTreeMap<(String, String, u64), TestCase> = BTreeMap::new();
             for row in rows {
-                let key = (row.plane.to_string(), row.direction.to_string(), row.accel_m_s2.to_bits());
+                let key = (
+                    row.plane.to_string(),
+                    row.direction.to_string(),
+                    row.accel_m_s2.to_bits(),
+                );
                 let case = groups.entry(key).or_insert_with(|| TestCase {
-                    source: format!("{name} ({} {} {} m/s²)", row.plane, row.direction, row.accel_m_s2),
+                    source: format!(
+                        "{name} ({} {} {} m/s²)",
+                        row.plane, row.direction, row.accel_m_s2
+                    ),
                     plane: row.plane,
                     direction: row.direction,
-                    radius_mm: opts.table_radius_mm,
+                    radius_mm: opts.radius_mm,
                     accel_m_s2: row.accel_m_s2,
                     measured: BTreeMap::new(),
                 });
-                case.measured
-                    .insert(row.parameter, (row.value, row.std_err.unwrap_or(opts.table_std_err)));
+                case.measured.insert(
+                    row.parameter,
+                    (row.value, row.std_err.unwrap_or(opts.table_std_err)),
+                );
             }
             tests.extend(groups.into_values());
         } else {
             let series = CircleSeries::read_csv(f).map_err(err)?;
-            let result = rtest::evaluate(&series, &EvalOptions::default()).map_err(err)?;
+            let eval = EvalOptions {
+                plane: None,
+                radius_mm: Some(opts.radius_mm),
+            };
+            let result = rtest::evaluate(&series, &eval).map_err(err)?;
             tests.push(TestCase {
                 source: name.clone(),
                 plane: result.plane,

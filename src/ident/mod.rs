@@ -194,12 +194,17 @@ pub struct TestCase {
 impl TestCase {
     /// A short label: `zx ccw 5.00 m/s²`.
     pub fn label(&self) -> String {
-        format!("{} {} {:.2} m/s²", self.plane, self.direction, self.accel_m_s2)
+        format!(
+            "{} {} {:.2} m/s²",
+            self.plane, self.direction, self.accel_m_s2
+        )
     }
 }
 
 /// Which optimiser.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum Method {
     /// Levenberg–Marquardt on the weighted residuals (default).
@@ -264,7 +269,12 @@ type EijMap = BTreeMap<Eij, f64>;
 
 impl Problem {
     /// Checks that the model can run every test and builds the problem.
-    pub fn new(machine: Machine, params: Vec<Parameter>, tests: Vec<TestCase>, settings: Settings) -> Result<Problem, IdentError> {
+    pub fn new(
+        machine: Machine,
+        params: Vec<Parameter>,
+        tests: Vec<TestCase>,
+        settings: Settings,
+    ) -> Result<Problem, IdentError> {
         if tests.is_empty() {
             return Err(IdentError::NoData("no measured tests given".into()));
         }
@@ -336,7 +346,10 @@ impl Problem {
 
     /// θ = ln p of the starting machine.
     pub fn initial_theta(&self) -> DVector<f64> {
-        DVector::from_iterator(self.params.len(), self.params.iter().map(|p| p.get(&self.machine).ln()))
+        DVector::from_iterator(
+            self.params.len(),
+            self.params.iter().map(|p| p.get(&self.machine).ln()),
+        )
     }
 
     /// The machine with factors exp(θ).
@@ -358,8 +371,18 @@ impl Problem {
     }
 
     /// Simulates and evaluates one test on a prepared closed loop.
-    fn run_test(&self, cl: &ClosedLoop, disc: &Discrete, test: &TestCase) -> Result<EijMap, String> {
-        let mut circle = Circle::new(test.plane, test.radius_mm * 1e-3, test.accel_m_s2, test.direction);
+    fn run_test(
+        &self,
+        cl: &ClosedLoop,
+        disc: &Discrete,
+        test: &TestCase,
+    ) -> Result<EijMap, String> {
+        let mut circle = Circle::new(
+            test.plane,
+            test.radius_mm * 1e-3,
+            test.accel_m_s2,
+            test.direction,
+        );
         circle.steady_revolutions = self.settings.revolutions;
         let run = simulate_discrete(cl, disc, &circle).map_err(|e| e.to_string())?;
         let series = output::to_series(cl, &run, test.label()).map_err(|e| e.to_string())?;
@@ -394,11 +417,12 @@ impl Problem {
             .map(|k| {
                 let (s, t) = (k / nt, k % nt);
                 let (cl, disc) = &loops[s];
-                self.run_test(cl, disc, &self.tests[t]).map_err(|message| IdentError::Simulation {
-                    test: self.tests[t].label(),
-                    params: self.describe(&thetas[s]),
-                    message,
-                })
+                self.run_test(cl, disc, &self.tests[t])
+                    .map_err(|message| IdentError::Simulation {
+                        test: self.tests[t].label(),
+                        params: self.describe(&thetas[s]),
+                        message,
+                    })
             })
             .collect();
         let mut out = Vec::with_capacity(thetas.len());
@@ -428,7 +452,10 @@ impl Problem {
     }
 
     /// Forward-difference Jacobian ∂r/∂θ at θ (columns in parallel) and the residuals there.
-    pub fn jacobian_at(&self, theta: &DVector<f64>) -> Result<(DMatrix<f64>, DVector<f64>), IdentError> {
+    pub fn jacobian_at(
+        &self,
+        theta: &DVector<f64>,
+    ) -> Result<(DMatrix<f64>, DVector<f64>), IdentError> {
         let h = self.settings.fd_step;
         let mut thetas = vec![theta.clone()];
         for i in 0..theta.len() {
@@ -479,7 +506,9 @@ impl Jacobian for Reduced<'_> {
     type Jacobian = DMatrix<f64>;
     fn jacobian(&self, theta: &DVector<f64>) -> Result<DMatrix<f64>, argmin::core::Error> {
         let (j, _) = self.problem.jacobian_at(&self.full(theta))?;
-        Ok(DMatrix::from_fn(j.nrows(), self.free.len(), |r, c| j[(r, self.free[c])]))
+        Ok(DMatrix::from_fn(j.nrows(), self.free.len(), |r, c| {
+            j[(r, self.free[c])]
+        }))
     }
 }
 
@@ -490,7 +519,10 @@ impl CostFunction for Reduced<'_> {
         let lo = self.problem.settings.min_factor.ln();
         let hi = self.problem.settings.max_factor.ln();
         let clamped = theta.map(|t| t.clamp(lo, hi));
-        Ok(self.problem.residuals_at(&self.full(&clamped))?.norm_squared())
+        Ok(self
+            .problem
+            .residuals_at(&self.full(&clamped))?
+            .norm_squared())
     }
 }
 
@@ -505,7 +537,11 @@ struct Progress {
 
 impl<I: State<Float = f64>> Observe<I> for Progress {
     fn observe_iter(&mut self, state: &I, _kv: &KV) -> Result<(), argmin::core::Error> {
-        let cost = if self.half { 2.0 * state.get_cost() } else { state.get_cost() };
+        let cost = if self.half {
+            2.0 * state.get_cost()
+        } else {
+            state.get_cost()
+        };
         if let Ok(mut c) = self.costs.lock() {
             c.push(cost);
         }
@@ -566,7 +602,10 @@ pub struct IdentResult {
 const UNIDENTIFIABLE: f64 = 1e-6;
 
 /// Runs the identification.
-pub fn identify(problem: &Problem, progress: Option<Arc<ProgressFn>>) -> Result<IdentResult, IdentError> {
+pub fn identify(
+    problem: &Problem,
+    progress: Option<Arc<ProgressFn>>,
+) -> Result<IdentResult, IdentError> {
     let s = &problem.settings;
     let theta0 = problem.initial_theta();
     let n = theta0.len();
@@ -623,8 +662,14 @@ pub fn identify(problem: &Problem, progress: Option<Arc<ProgressFn>>) -> Result<
                 .run()
                 .map_err(|e| IdentError::Optimiser(format!("{e:#}")))?;
             let st = res.state();
-            let converged = matches!(st.get_termination_reason(), Some(TerminationReason::SolverConverged));
-            let p = st.get_best_param().cloned().ok_or_else(|| IdentError::Optimiser("no result".into()))?;
+            let converged = matches!(
+                st.get_termination_reason(),
+                Some(TerminationReason::SolverConverged)
+            );
+            let p = st
+                .get_best_param()
+                .cloned()
+                .ok_or_else(|| IdentError::Optimiser("no result".into()))?;
             (p, st.get_iter(), converged)
         }
         Method::NelderMead => {
@@ -648,8 +693,14 @@ pub fn identify(problem: &Problem, progress: Option<Arc<ProgressFn>>) -> Result<
                 .run()
                 .map_err(|e| IdentError::Optimiser(format!("{e:#}")))?;
             let st = res.state();
-            let converged = matches!(st.get_termination_reason(), Some(TerminationReason::SolverConverged));
-            let p = st.get_best_param().cloned().ok_or_else(|| IdentError::Optimiser("no result".into()))?;
+            let converged = matches!(
+                st.get_termination_reason(),
+                Some(TerminationReason::SolverConverged)
+            );
+            let p = st
+                .get_best_param()
+                .cloned()
+                .ok_or_else(|| IdentError::Optimiser("no result".into()))?;
             (p.map(|t| t.clamp(lo, hi)), st.get_iter(), converged)
         }
     };

@@ -56,8 +56,10 @@ pub fn report_json(problem: &Problem, result: &IdentResult, prov: &Provenance) -
         .iter()
         .enumerate()
         .map(|(i, t)| {
-            let measured: std::collections::BTreeMap<_, _> = t.measured.iter().map(|(p, (v, _))| (*p, *v)).collect();
-            let sigma: std::collections::BTreeMap<_, _> = t.measured.iter().map(|(p, (_, s))| (*p, *s)).collect();
+            let measured: std::collections::BTreeMap<_, _> =
+                t.measured.iter().map(|(p, (v, _))| (*p, *v)).collect();
+            let sigma: std::collections::BTreeMap<_, _> =
+                t.measured.iter().map(|(p, (_, s))| (*p, *s)).collect();
             let ratio = |sim: &std::collections::BTreeMap<crate::axes::Eij, f64>| {
                 let r: std::collections::BTreeMap<_, _> = measured
                     .iter()
@@ -117,10 +119,17 @@ pub fn report_json(problem: &Problem, result: &IdentResult, prov: &Provenance) -
 
 /// The identified machine as TOML text: the machine file with the identified factors, a
 /// comment header and a `[provenance]` table saying from what and how it was identified.
-pub fn machine_toml(problem: &Problem, result: &IdentResult, prov: &Provenance) -> Result<String, String> {
+pub fn machine_toml(
+    problem: &Problem,
+    result: &IdentResult,
+    prov: &Provenance,
+) -> Result<String, String> {
     let mut raw = result.machine.to_raw();
     let mut p = toml::Table::new();
-    p.insert("identified_by".into(), format!("eij {}", env!("CARGO_PKG_VERSION")).into());
+    p.insert(
+        "identified_by".into(),
+        format!("eij {}", env!("CARGO_PKG_VERSION")).into(),
+    );
     p.insert("date".into(), prov.date.clone().into());
     p.insert("from_machine".into(), prov.machine_file.clone().into());
     p.insert(
@@ -155,8 +164,14 @@ pub fn machine_toml(problem: &Problem, result: &IdentResult, prov: &Provenance) 
     header.push_str("# Stiffness = catalogue value × reduction factor; identified factors:\n");
     for q in &result.parameters {
         match q.std_err {
-            Some(s) => header.push_str(&format!("#   {} = {:.4} ± {:.4} (start {})\n", q.name, q.value, s, q.initial)),
-            None => header.push_str(&format!("#   {} = {} (not identifiable, unchanged)\n", q.name, q.value)),
+            Some(s) => header.push_str(&format!(
+                "#   {} = {:.4} ± {:.4} (start {})\n",
+                q.name, q.value, s, q.initial
+            )),
+            None => header.push_str(&format!(
+                "#   {} = {} (not identifiable, unchanged)\n",
+                q.name, q.value
+            )),
         }
     }
     header.push('\n');

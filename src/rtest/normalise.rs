@@ -13,6 +13,11 @@ use std::f64::consts::{PI, TAU};
 pub const PROBE_RANGE_MM: f64 = 3.0;
 /// Relative band around the plateau angular speed that counts as steady.
 pub const STEADY_TOLERANCE: f64 = 0.005;
+
+/// The wider band of the first pass, whose phase is taken about the mid-range centre: a centre
+/// off by δ makes the local speed ripple by ±δ/r (a file that starts at rest on the set radius
+/// while the steady path runs on a smaller one puts the mid-range off by half the difference).
+const COARSE_TOLERANCE: f64 = 0.03;
 /// Fewest samples per revolution accepted.
 pub const MIN_SAMPLES_PER_REVOLUTION: usize = 36;
 /// Largest radius (mm) accepted for an R-Test circle before suspecting µm in mm columns.
@@ -110,9 +115,14 @@ pub fn normalise(series: &CircleSeries, opts: &EvalOptions) -> Result<Normalised
     let t = series.t_s();
     // The mid-range is centre enough to find the steady part; the least-squares centre of the
     // steady revolutions follows.
+    // Two passes: the mid-range centre finds the steady part roughly, the least-squares centre
+    // of that part gives the phase whose speed plateau decides the whole revolutions.
     let centre0 = [mid_range(ai), mid_range(bi)];
     let phase0 = unwrapped_phase(ai, bi, centre0);
-    let (first, end, revolutions) = steady_revolutions(t, &phase0, &whole)?;
+    let (f0, e0, _) = steady_revolutions(t, &phase0, COARSE_TOLERANCE, &whole)?;
+    let centre1 = circle_centre(&ai[f0..e0], &bi[f0..e0]).unwrap_or(centre0);
+    let phase1 = unwrapped_phase(ai, bi, centre1);
+    let (first, end, revolutions) = steady_revolutions(t, &phase1, STEADY_TOLERANCE, &whole)?;
     let spr = (end - first) / revolutions;
     if spr < MIN_SAMPLES_PER_REVOLUTION {
         return Err(RtestError::TooShort {
@@ -385,6 +395,7 @@ fn slope(t: &[f64], y: &[f64]) -> f64 {
 fn steady_revolutions(
     t: &[f64],
     phase: &[f64],
+    tolerance: f64,
     whole: &dyn Fn() -> Location,
 ) -> Result<(usize, usize, usize), RtestError> {
     let n = phase.len();
@@ -434,13 +445,13 @@ fn steady_revolutions(
         }
         h = h_plateau;
     }
-    let (mut k0, mut k1) = longest_run(&speed, reference);
+    let (mut k0, mut k1) = longest_run(&speed, reference, tolerance);
     scratch.clear();
     scratch.extend_from_slice(&speed[k0..=k1]);
     let run = scratch.as_mut_slice();
     let mid = run.len() / 2;
     let (_, median, _) = run.select_nth_unstable_by(mid, f64::total_cmp);
-    (k0, k1) = longest_run(&speed, *median);
+    (k0, k1) = longest_run(&speed, *median, tolerance);
     let (k0, k1) = (k0 + h, k1 + h);
     let span = sign * (phase[k1] - phase[k0]);
     let revolutions = (span / TAU + 1e-9).floor();
@@ -460,9 +471,9 @@ fn steady_revolutions(
     Ok((first, end, revolutions as usize))
 }
 
-/// Longest run of `speed` within [`STEADY_TOLERANCE`] of `reference`, as inclusive indices.
-fn longest_run(speed: &[f64], reference: f64) -> (usize, usize) {
-    let tol = STEADY_TOLERANCE * reference;
+/// Longest run of `speed` within `tolerance` (relative) of `reference`, as inclusive indices.
+fn longest_run(speed: &[f64], reference: f64, tolerance: f64) -> (usize, usize) {
+    let tol = tolerance * reference;
     let (mut best, mut start) = ((0, 0), None);
     let mut best_len = 0;
     for (k, s) in speed.iter().enumerate() {

@@ -96,7 +96,9 @@ fn columns(cl: &ClosedLoop, required_only: bool) -> Vec<(String, Source)> {
 pub fn to_csv(cl: &ClosedLoop, run: &Run, opts: &CsvOptions) -> Vec<u8> {
     let cols = columns(cl, opts.required_only);
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(opts.seed);
-    let noise = Normal::new(0.0, opts.noise_um * 1e-3).ok().filter(|_| opts.noise_um > 0.0);
+    let noise = Normal::new(0.0, opts.noise_um * 1e-3)
+        .ok()
+        .filter(|_| opts.noise_um > 0.0);
     let mut w = csv::Writer::from_writer(Vec::with_capacity(run.len() * cols.len() * 16));
     // Writing to memory cannot fail.
     let _ = w.write_record(cols.iter().map(|(n, _)| n.as_str()));
