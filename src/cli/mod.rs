@@ -4,6 +4,7 @@ use clap::{Parser, Subcommand};
 
 pub mod evaluate;
 mod export;
+mod identify;
 mod machine_args;
 mod modal;
 mod simulate;
@@ -26,6 +27,10 @@ enum Command {
     Modal(modal::ModalArgs),
     /// Export the assembled model (M, D, K) and the closed loop (A, B, C, D) as JSON.
     Export(export::ExportArgs),
+    /// Identify stiffness reduction factors from measured EIJ (defaults: the bundled demo).
+    Identify(identify::IdentifyArgs),
+    /// Re-run stored known-good identifications and fail if a result drifts.
+    Verify(identify::VerifyArgs),
 }
 
 impl Cli {
@@ -36,6 +41,8 @@ impl Cli {
             Command::Simulate(args) => simulate::run(args),
             Command::Modal(args) => modal::run(args),
             Command::Export(args) => export::run(args),
+            Command::Identify(args) => identify::run(args),
+            Command::Verify(args) => identify::verify(args),
         }
     }
 }

@@ -27,6 +27,8 @@ pub struct IdentConfig {
     pub revolutions: Option<u32>,
     /// Set radius of the circle tests, mm (2).
     pub radius_mm: Option<f64>,
+    /// Axis positions of the circle centre, mm (for tests whose folder does not say).
+    pub position_mm: Option<Vec<f64>>,
     /// σ of table values without a standard error, µm·s²/m.
     pub table_std_err_um_s2_per_m: Option<f64>,
 }
@@ -83,6 +85,12 @@ impl IdentConfig {
                 return Err(bad("revolutions", v.to_string()));
             }
             s.revolutions = v;
+        }
+        if let Some(p) = &self.position_mm {
+            if p.iter().any(|v| !v.is_finite()) {
+                return Err(bad("position_mm", format!("{p:?}")));
+            }
+            s.position_m = Some(p.iter().map(|v| v * 1e-3).collect());
         }
         if s.min_factor >= s.max_factor {
             return Err(bad(

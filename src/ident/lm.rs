@@ -110,7 +110,13 @@ where
             let c_new = half_sq(&r_new);
             if c_new < cost {
                 self.lambda = (self.lambda / 3.0).max(1e-12);
-                if cost - c_new <= self.tol_cost * cost || step <= self.tol_step {
+                // Converged: a negligible relative decrease, a negligible step, or a fit at the
+                // level of rounding (rms residual below 1e-7 σ).
+                let rounding = 0.5e-14 * r_new.len() as f64;
+                if cost - c_new <= self.tol_cost * cost
+                    || step <= self.tol_step
+                    || c_new <= rounding
+                {
                     self.converged = true;
                 }
                 let kv = argmin::kv!("lambda" => self.lambda; "step" => step;);

@@ -41,6 +41,53 @@ fn is_table(path: &Path) -> bool {
         .unwrap_or(false)
 }
 
+/// Conditions of the R-Test files of one folder, from its optional `rtest.toml`.
+#[derive(Debug, Clone, Default, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FolderConditions {
+    /// Set radius of the circles, mm.
+    pub radius_mm: Option<f64>,
+    /// Axis positions of the circle centre, mm (machine axis order).
+    pub position_mm: Option<Vec<f64>>,
+}
+
+/// The file of a folder that states its test conditions.
+pub const CONDITIONS_FILE: &str = "rtest.toml";
+
+fn folder_conditions(dir: &Path) -> Result<FolderConditions, IdentError> {
+    let file = dir.join(CONDITIONS_FILE);
+    if !file.is_file() {
+        return Ok(FolderConditions::default());
+    }
+    let name = file.display().to_string();
+    let text = std::fs::read_to_string(&file).map_err(|e| IdentError::Test {
+        input: name.clone(),
+        message: format!("cannot read: {e}"),
+    })?;
+    let c: FolderConditions = toml::from_str(&text).map_err(|e| IdentError::Test {
+        input: name.clone(),
+        message: e.message().trim().replace('\n', " "),
+    })?;
+    if let Some(r) = c.radius_mm {
+        if !(r.is_finite() && r > 0.0 && r <= 3.0) {
+            return Err(IdentError::Test {
+                input: name,
+                message: format!("radius_mm = {r} must lie in (0, 3] mm"),
+            });
+        }
+    }
+    if c.position_mm
+        .as_ref()
+        .is_some_and(|p| p.iter().any(|v| !v.is_finite()))
+    {
+        return Err(IdentError::Test {
+            input: name,
+            message: "position_mm must be finite".into(),
+        });
+    }
+    Ok(c)
+}
+
 /// Expands folders (their `*.csv`, sorted) and keeps files.
 pub fn expand(paths: &[PathBuf]) -> Result<Vec<PathBuf>, IdentError> {
     let mut files = Vec::new();
@@ -74,9 +121,34 @@ pub fn expand(paths: &[PathBuf]) -> Result<Vec<PathBuf>, IdentError> {
 /// Reads every path into test cases (R-Test series are evaluated; tables grouped by plane,
 /// direction and acceleration).
 pub fn load(paths: &[PathBuf], opts: &MeasuredOptions) -> Result<Vec<TestCase>, IdentError> {
-    let files = expand(paths)?;
     let mut tests = Vec::new();
-    for f in &files {
+    for p in paths {
+        let conditions = if p.is_dir() {
+            folder_conditions(p)?
+        } else {
+            FolderConditions::default()
+        };
+        tests.extend(load_files(
+            &expand(std::slice::from_ref(p))?,
+            opts,
+            &conditions,
+        )?);
+    }
+    Ok(tests)
+}
+
+fn load_files(
+    files: &[PathBuf],
+    opts: &MeasuredOptions,
+    cond: &FolderConditions,
+) -> Result<Vec<TestCase>, IdentError> {
+    let radius_mm = cond.radius_mm.unwrap_or(opts.radius_mm);
+    let position_m = cond
+        .position_mm
+        .as_ref()
+        .map(|p| p.iter().map(|v| v * 1e-3).collect::<Vec<f64>>());
+    let mut tests = Vec::new();
+    for f in files {
         let name = f.display().to_string();
         let err = |e: rtest::RtestError| IdentError::Test {
             input: name.clone(),
@@ -98,8 +170,9 @@ pub fn load(paths: &[PathBuf], opts: &MeasuredOptions) -> Result<Vec<TestCase>, 
                     ),
                     plane: row.plane,
                     direction: row.direction,
-                    radius_mm: opts.radius_mm,
+                    radius_mm,
                     accel_m_s2: row.accel_m_s2,
+                    position_m: position_m.clone(),
                     measured: BTreeMap::new(),
                 });
                 case.measured.insert(
@@ -112,7 +185,7 @@ pub fn load(paths: &[PathBuf], opts: &MeasuredOptions) -> Result<Vec<TestCase>, 
             let series = CircleSeries::read_csv(f).map_err(err)?;
             let eval = EvalOptions {
                 plane: None,
-                radius_mm: Some(opts.radius_mm),
+                radius_mm: Some(radius_mm),
             };
             let result = rtest::evaluate(&series, &eval).map_err(err)?;
             tests.push(TestCase {
@@ -121,6 +194,7 @@ pub fn load(paths: &[PathBuf], opts: &MeasuredOptions) -> Result<Vec<TestCase>, 
                 direction: result.direction,
                 radius_mm: result.radius_mm,
                 accel_m_s2: result.accel_m_s2,
+                position_m: position_m.clone(),
                 measured: result
                     .eij
                     .iter()

@@ -1,7 +1,12 @@
 //! Identification: stiffness reduction factors (and the like) fitted so that the simulated
 //! circle tests reproduce the measured EIJ.
 //!
-//! Parameters p are optimised as θ = ln p (positive by construction, bounds on θ). The residuals
+//! Parameters p are optimised as compliance factors θ = 1/p, within bounds
+//! 1/p_max ≤ θ ≤ 1/p_min (positive by construction). Deviations at the TCP are sums of elastic
+//! deflections, each proportional to a compliance, so EIJ are nearly linear in θ: Gauss–Newton
+//! steps then travel straight along the weakly determined combinations (e.g. X against Y
+//! guideway compliance, both tilted by the same accelerations) instead of crawling along the
+//! curved valley that ln p makes of them. The residuals
 //! are r = (E_sim(p) − E_meas)/σ over every (test, EIJ) pair, where E_sim comes from simulating
 //! the very same circle test (plane, direction, radius, acceleration) on the model and
 //! evaluating it with the very same evaluation ([`crate::rtest`]). The finite-difference
@@ -187,6 +192,9 @@ pub struct TestCase {
     pub radius_mm: f64,
     /// Set acceleration, m/s².
     pub accel_m_s2: f64,
+    /// Axis positions of the circle centre, m (`None`: [`Settings::position_m`], else the
+    /// machine's reference position).
+    pub position_m: Option<Vec<f64>>,
     /// Measured value and standard uncertainty σ per parameter, µm·s²/m.
     pub measured: BTreeMap<Eij, (f64, f64)>,
 }
@@ -218,7 +226,7 @@ pub enum Method {
 pub struct Settings {
     /// Output rate of the simulated tests, Hz (2000).
     pub rate_hz: f64,
-    /// Steady revolutions per simulated test (3).
+    /// Steady revolutions per simulated test (4).
     pub revolutions: u32,
     /// Lower bound of every factor (0.01).
     pub min_factor: f64,
@@ -228,29 +236,49 @@ pub struct Settings {
     pub max_iters: u64,
     /// Relative cost decrease that counts as converged (1e-10).
     pub tol_cost: f64,
-    /// Step in ln p that counts as converged (1e-8).
+    /// Step in θ = 1/p that counts as converged (1e-8).
     pub tol_step: f64,
-    /// Finite-difference step in ln p (1e-4).
+    /// Central-difference step, relative to θ (1e-3).
     pub fd_step: f64,
     /// Optimiser.
     pub method: Method,
     /// Smallest σ used to weight a measured value, µm·s²/m (1e-3): keeps noise-free data finite.
     pub sigma_floor: f64,
+    /// Axis positions of the circle centre, m (machine axis order; `None`: reference position).
+    pub position_m: Option<Vec<f64>>,
+}
+
+impl Settings {
+    /// Bounds of θ = 1/p.
+    pub fn theta_bounds(&self) -> (f64, f64) {
+        (1.0 / self.max_factor, 1.0 / self.min_factor)
+    }
+}
+
+/// Compliance factor θ = 1/p of a stiffness factor p.
+fn to_theta(p: f64) -> f64 {
+    1.0 / p
+}
+
+/// Stiffness factor p = 1/θ.
+fn to_factor(theta: f64) -> f64 {
+    1.0 / theta
 }
 
 impl Default for Settings {
     fn default() -> Self {
         Settings {
             rate_hz: 2000.0,
-            revolutions: 3,
+            revolutions: 4,
             min_factor: 0.01,
             max_factor: 10.0,
             max_iters: 50,
             tol_cost: 1e-10,
             tol_step: 1e-8,
-            fd_step: 1e-4,
+            fd_step: 1e-3,
             method: Method::Lm,
             sigma_floor: 1e-3,
+            position_m: None,
         }
     }
 }
@@ -262,7 +290,10 @@ pub struct Problem {
     params: Vec<Parameter>,
     tests: Vec<TestCase>,
     settings: Settings,
-    pose: Vec<f64>,
+    /// Distinct circle-centre positions of the tests.
+    poses: Vec<Vec<f64>>,
+    /// Index into `poses` per test.
+    test_pose: Vec<usize>,
 }
 
 type EijMap = BTreeMap<Eij, f64>;
@@ -319,13 +350,14 @@ impl Problem {
                 });
             }
         }
-        let pose = machine.reference_pose();
+        let (poses, test_pose) = distinct_poses(&machine, &tests, &settings)?;
         Ok(Problem {
             machine,
             params,
             tests,
             settings,
-            pose,
+            poses,
+            test_pose,
         })
     }
 
@@ -344,19 +376,19 @@ impl Problem {
         &self.machine
     }
 
-    /// θ = ln p of the starting machine.
+    /// θ = 1/p of the starting machine.
     pub fn initial_theta(&self) -> DVector<f64> {
         DVector::from_iterator(
             self.params.len(),
-            self.params.iter().map(|p| p.get(&self.machine).ln()),
+            self.params.iter().map(|p| to_theta(p.get(&self.machine))),
         )
     }
 
-    /// The machine with factors exp(θ).
+    /// The machine with factors p = 1/θ.
     pub fn machine_at(&self, theta: &DVector<f64>) -> Machine {
         let mut m = self.machine.clone();
         for (p, t) in self.params.iter().zip(theta.iter()) {
-            p.set(&mut m, t.exp());
+            p.set(&mut m, to_factor(*t));
         }
         m
     }
@@ -365,7 +397,7 @@ impl Problem {
         self.params
             .iter()
             .zip(theta.iter())
-            .map(|(p, t)| format!("{}={:.4}", p.name, t.exp()))
+            .map(|(p, t)| format!("{}={:.4}", p.name, to_factor(*t)))
             .collect::<Vec<_>>()
             .join(", ")
     }
@@ -397,14 +429,18 @@ impl Problem {
     /// Simulated EIJ of every test for every parameter vector, in parallel over all
     /// (parameter vector, test) pairs; the order of the result does not depend on threads.
     pub fn simulate_many(&self, thetas: &[DVector<f64>]) -> Result<Vec<Vec<EijMap>>, IdentError> {
-        let loops: Vec<Result<(ClosedLoop, Discrete), IdentError>> = thetas
-            .par_iter()
-            .map(|theta| {
+        let np = self.poses.len();
+        let loops: Vec<Result<(ClosedLoop, Discrete), IdentError>> = (0..thetas.len() * np)
+            .into_par_iter()
+            .map(|k| {
+                let theta = &thetas[k / np];
                 let m = self.machine_at(theta);
-                let cl = ClosedLoop::new(&m, &self.pose).map_err(|e| IdentError::Simulation {
-                    test: "closed loop".into(),
-                    params: self.describe(theta),
-                    message: e.to_string(),
+                let cl = ClosedLoop::new(&m, &self.poses[k % np]).map_err(|e| {
+                    IdentError::Simulation {
+                        test: "closed loop".into(),
+                        params: self.describe(theta),
+                        message: e.to_string(),
+                    }
                 })?;
                 let disc = Discrete::new(&cl, 1.0 / self.settings.rate_hz);
                 Ok((cl, disc))
@@ -416,7 +452,7 @@ impl Problem {
             .into_par_iter()
             .map(|k| {
                 let (s, t) = (k / nt, k % nt);
-                let (cl, disc) = &loops[s];
+                let (cl, disc) = &loops[s * np + self.test_pose[t]];
                 self.run_test(cl, disc, &self.tests[t])
                     .map_err(|message| IdentError::Simulation {
                         test: self.tests[t].label(),
@@ -451,27 +487,86 @@ impl Problem {
         Ok(self.residuals_of(&sims[0]))
     }
 
-    /// Forward-difference Jacobian ∂r/∂θ at θ (columns in parallel) and the residuals there.
+    /// Central-difference Jacobian ∂r/∂θ at θ (all 2n + 1 parameter sets in parallel) and the
+    /// residuals there. Central differences matter: the tests determine some combinations
+    /// thousands of times more weakly than others, and a forward difference's O(h) error would
+    /// swamp those directions.
     pub fn jacobian_at(
         &self,
         theta: &DVector<f64>,
     ) -> Result<(DMatrix<f64>, DVector<f64>), IdentError> {
-        let h = self.settings.fd_step;
+        let h: Vec<f64> = theta
+            .iter()
+            .map(|t| self.settings.fd_step * t.abs())
+            .collect();
         let mut thetas = vec![theta.clone()];
         for i in 0..theta.len() {
-            let mut t = theta.clone();
-            t[i] += h;
-            thetas.push(t);
+            for sign in [1.0, -1.0] {
+                let mut t = theta.clone();
+                t[i] += sign * h[i];
+                thetas.push(t);
+            }
         }
         let sims = self.simulate_many(&thetas)?;
         let r0 = self.residuals_of(&sims[0]);
         let mut j = DMatrix::zeros(r0.len(), theta.len());
         for i in 0..theta.len() {
-            let ri = self.residuals_of(&sims[i + 1]);
-            j.set_column(i, &((ri - &r0) / h));
+            let plus = self.residuals_of(&sims[1 + 2 * i]);
+            let minus = self.residuals_of(&sims[2 + 2 * i]);
+            j.set_column(i, &((plus - minus) / (2.0 * h[i])));
         }
         Ok((j, r0))
     }
+}
+
+/// The distinct circle-centre positions of the tests (checked against the strokes) and the
+/// index of each test's position.
+fn distinct_poses(
+    machine: &Machine,
+    tests: &[TestCase],
+    settings: &Settings,
+) -> Result<(Vec<Vec<f64>>, Vec<usize>), IdentError> {
+    let default = settings
+        .position_m
+        .clone()
+        .unwrap_or_else(|| machine.reference_pose());
+    let mut poses: Vec<Vec<f64>> = Vec::new();
+    let mut index = Vec::with_capacity(tests.len());
+    for t in tests {
+        let pose = t.position_m.clone().unwrap_or_else(|| default.clone());
+        crate::mbs::Model::assemble(machine, &pose).map_err(|e| IdentError::Test {
+            input: t.source.clone(),
+            message: format!("test position: {e}"),
+        })?;
+        let i = match poses.iter().position(|p| *p == pose) {
+            Some(i) => i,
+            None => {
+                poses.push(pose);
+                poses.len() - 1
+            }
+        };
+        index.push(i);
+    }
+    Ok((poses, index))
+}
+
+/// Simulated EIJ of `tests` (their conditions; measured values are ignored) on `machine`,
+/// exactly as the identification computes them.
+pub fn simulated_eij(
+    machine: &Machine,
+    tests: &[TestCase],
+    settings: &Settings,
+) -> Result<Vec<EijMap>, IdentError> {
+    let (poses, test_pose) = distinct_poses(machine, tests, settings)?;
+    let problem = Problem {
+        machine: machine.clone(),
+        params: Vec::new(),
+        tests: tests.to_vec(),
+        settings: settings.clone(),
+        poses,
+        test_pose,
+    };
+    Ok(problem.simulate_many(&[DVector::zeros(0)])?.remove(0))
 }
 
 /// The problem restricted to the identifiable parameters, as argmin sees it.
@@ -516,8 +611,7 @@ impl CostFunction for Reduced<'_> {
     type Param = DVector<f64>;
     type Output = f64;
     fn cost(&self, theta: &DVector<f64>) -> Result<f64, argmin::core::Error> {
-        let lo = self.problem.settings.min_factor.ln();
-        let hi = self.problem.settings.max_factor.ln();
+        let (lo, hi) = self.problem.settings.theta_bounds();
         let clamped = theta.map(|t| t.clamp(lo, hi));
         Ok(self
             .problem
@@ -574,7 +668,7 @@ pub struct IdentResult {
     pub parameters: Vec<Identified>,
     /// Correlation matrix of the identifiable parameters (order of `parameters`, others 0).
     pub correlation: DMatrix<f64>,
-    /// Singular values of the weighted Jacobian ∂r/∂ln p at the solution, descending.
+    /// Singular values of the weighted Jacobian ∂r/∂θ (θ = 1/p) at the solution, descending.
     pub singular_values: Vec<f64>,
     /// Σr² at the start.
     pub cost_initial: f64,
@@ -621,7 +715,7 @@ pub fn identify(
         warnings.push(format!(
             "{} is not identifiable from the tests given (no influence on any measured EIJ); kept at {}",
             problem.params[i].name,
-            theta0[i].exp()
+            to_factor(theta0[i])
         ));
     }
     if free.is_empty() {
@@ -641,7 +735,7 @@ pub fn identify(
         base: theta0.clone(),
     };
     let start = DVector::from_iterator(free.len(), free.iter().map(|&i| theta0[i]));
-    let (lo, hi) = (s.min_factor.ln(), s.max_factor.ln());
+    let (lo, hi) = s.theta_bounds();
     let costs = Arc::new(Mutex::new(Vec::new()));
     let (theta_free, iterations, converged) = match s.method {
         Method::Lm => {
@@ -676,7 +770,7 @@ pub fn identify(
             let mut simplex = vec![start.clone()];
             for i in 0..start.len() {
                 let mut v = start.clone();
-                v[i] += 0.3;
+                v[i] *= 1.3;
                 simplex.push(v);
             }
             let solver = argmin::solver::neldermead::NelderMead::new(simplex)
@@ -719,7 +813,7 @@ pub fn identify(
             return Err(IdentError::NotConverged(format!(
                 "{} ended at its bound {} (allowed [{}, {}]): the data want a value outside; widen the bounds or check the data; nothing exported",
                 problem.params[i].name,
-                theta[i].exp(),
+                to_factor(theta[i]),
                 s.min_factor,
                 s.max_factor
             )));
@@ -764,9 +858,10 @@ pub fn identify(
             let fi = free.iter().position(|&f| f == i);
             Identified {
                 name: p.name.clone(),
-                initial: theta0[i].exp(),
-                value: theta[i].exp(),
-                std_err: fi.map(|k| theta[i].exp() * cov[(k, k)].max(0.0).sqrt()),
+                initial: to_factor(theta0[i]),
+                value: to_factor(theta[i]),
+                // p = 1/θ: σ_p = σ_θ/θ².
+                std_err: fi.map(|k| cov[(k, k)].max(0.0).sqrt() / (theta[i] * theta[i])),
                 identifiable: fi.is_some(),
             }
         })

@@ -386,8 +386,9 @@ fn slope(t: &[f64], y: &[f64]) -> f64 {
 
 /// Finds the steady part and keeps only whole revolutions of it.
 ///
-/// The local angular speed is the phase difference over a window of about 1/4 revolution
-/// (`±h` samples). The plateau speed is first taken as the 90th percentile of the speeds above
+/// The local angular speed is the phase difference over a window of half a revolution
+/// (`±h` samples, h = 1/4 revolution): the phase ripple at 2ω of an elliptic internal path
+/// (axes that lag differently) has exactly that period and cancels. The plateau speed is first taken as the 90th percentile of the speeds above
 /// half the largest one (dwells and slow ramp parts do not count) and refined as the median
 /// over the plateau; the plateau is the longest run within [`STEADY_TOLERANCE`] of
 /// that speed. Of it the largest whole number of revolutions is kept, centred, so that the
@@ -421,9 +422,9 @@ fn steady_revolutions(
         *v.select_nth_unstable_by(q, f64::total_cmp).1
     };
     // The mean speed over the whole file underestimates the plateau speed (dwells, ramps), so
-    // the first window is too wide; it is narrowed to 1/4 of a plateau revolution once.
+    // the first window is too wide; it is narrowed to half a plateau revolution once.
     let mean_dt = (t[n - 1] - t[0]) / (n - 1) as f64;
-    let mut h = ((n as f64 * TAU / total.abs() / 8.0) as usize).max(1);
+    let mut h = ((n as f64 * TAU / total.abs() / 4.0) as usize).max(1);
     let (mut speed, mut scratch, mut reference): (Vec<f64>, Vec<f64>, f64);
     loop {
         if n < 2 * h + 3 {
@@ -439,7 +440,7 @@ fn steady_revolutions(
         if reference <= 0.0 {
             return Err(too_short("no steady rotation found".into()));
         }
-        let h_plateau = ((TAU / (reference * mean_dt) / 8.0) as usize).max(1);
+        let h_plateau = ((TAU / (reference * mean_dt) / 4.0) as usize).max(1);
         if 2 * h_plateau >= h {
             break;
         }
