@@ -836,6 +836,13 @@ pub fn identify(
             ));
         }
     }
+    // χ² test of the fit: with honest σ, s² = χ²/(m − n) scatters about 1 by √(2/(m − n)).
+    if s2 > 1.0 + 4.0 * (2.0 / dof).sqrt() {
+        warnings.push(format!(
+            "residual std s = {:.2} ≫ 1: the model cannot reproduce the measured EIJ within their uncertainty (a missing parameter, a model error, or σ too small); standard errors are scaled by s",
+            s2.sqrt()
+        ));
+    }
     let jtj = j.transpose() * &j;
     let cov = jtj
         .clone()
@@ -850,7 +857,7 @@ pub fn identify(
             correlation[(i, k)] = if d > 0.0 { cov[(a, b)] / d } else { 0.0 };
         }
     }
-    let parameters = problem
+    let parameters: Vec<Identified> = problem
         .params
         .iter()
         .enumerate()
@@ -866,6 +873,14 @@ pub fn identify(
             }
         })
         .collect();
+    for q in &parameters {
+        if let Some(se) = q.std_err.filter(|se| *se > 0.5 * q.value) {
+            warnings.push(format!(
+                "{} = {:.3} ± {:.3} is only weakly determined by these tests (correlated with others, see the correlation matrix)",
+                q.name, q.value, se
+            ));
+        }
+    }
     let sims = problem.simulate_many(&[theta0.clone(), theta.clone()])?;
     let cost_history = costs.lock().map(|c| c.clone()).unwrap_or_default();
     Ok(IdentResult {

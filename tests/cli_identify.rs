@@ -1,0 +1,221 @@
+//! `eij identify` from the command line: outputs on success, one clear line and no output on
+//! failure.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+struct Scratch(PathBuf);
+
+impl Scratch {
+    fn new(tag: &str) -> Self {
+        let d = std::env::temp_dir().join(format!("eij-cli-ident-{tag}-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        Scratch(d)
+    }
+    fn path(&self, name: &str) -> PathBuf {
+        self.0.join(name)
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// Runs identify on three ZX files with the Z guideway factors, plus `extra` arguments.
+fn identify(s: &Scratch, extra: &[&str]) -> Output {
+    let zx = |n: &str| root().join("measurements/demo-vmc").join(n);
+    Command::new(env!("CARGO_BIN_EXE_eij"))
+        .current_dir(root())
+        .args([
+            "identify",
+            "--quiet",
+            "--machine",
+            "machines/demo-vmc.toml",
+            "--measured",
+        ])
+        .arg(zx("zx_ccw_4.csv"))
+        .arg(zx("zx_cw_6.csv"))
+        .arg(zx("zx_ccw_8.csv"))
+        .args([
+            "--param",
+            "z.guideway_normal",
+            "--param",
+            "z.guideway_lateral",
+            "--out",
+        ])
+        .arg(s.path("id.toml"))
+        .arg("--report")
+        .arg(s.path("id.json"))
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
+fn assert_failed_cleanly(s: &Scratch, out: &Output, expected: &str) {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "succeeded: {stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(stderr.contains(expected), "'{expected}' not in {stderr}");
+    assert!(!stderr.contains("panicked"));
+    assert!(
+        !s.path("id.toml").exists() && !s.path("id.json").exists(),
+        "output written on failure"
+    );
+    let leftovers = std::fs::read_dir(&s.0).unwrap().count();
+    assert_eq!(leftovers, 0, "temporary files left behind");
+}
+
+#[test]
+fn identified_machine_and_report_are_written_and_reload() {
+    let s = Scratch::new("ok");
+    let out = identify(&s, &[]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // The exported machine file is a valid machine with the identified factors.
+    let m = eij::machine::Machine::from_file(&s.path("id.toml")).unwrap();
+    let z = m.axis(eij::axes::Axis::Z).unwrap();
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(s.path("id.json")).unwrap()).unwrap();
+    let p = &json["parameters"][0];
+    assert_eq!(p["name"], "z.guideway_normal");
+    assert_eq!(
+        z.guideway.reduction_normal,
+        p["identified"].as_f64().unwrap()
+    );
+    assert!(p["std_err"].as_f64().unwrap() > 0.0);
+    for key in [
+        "cost_initial",
+        "cost_final",
+        "correlation",
+        "jacobian_singular_values",
+    ] {
+        assert!(!json[key].is_null(), "missing {key}");
+    }
+    let t = &json["tests"][0];
+    for key in [
+        "plane",
+        "direction",
+        "accel_m_s2",
+        "measured",
+        "simulated_initial",
+        "simulated_final",
+    ] {
+        assert!(!t[key].is_null(), "missing tests[0].{key}");
+    }
+    let text = std::fs::read_to_string(s.path("id.toml")).unwrap();
+    assert!(text.starts_with("# Identified by eij"));
+    assert!(text.contains("[provenance]"));
+}
+
+#[test]
+fn reports_are_identical_across_runs_and_thread_counts() {
+    let a = Scratch::new("det-a");
+    let b = Scratch::new("det-b");
+    let run = |s: &Scratch, threads: &str| {
+        let zx = root().join("measurements/demo-vmc/zx_ccw_4.csv");
+        let out = Command::new(env!("CARGO_BIN_EXE_eij"))
+            .current_dir(root())
+            .env("RAYON_NUM_THREADS", threads)
+            .env("SOURCE_DATE_EPOCH", "1700000000")
+            .args([
+                "identify",
+                "--quiet",
+                "--param",
+                "z.guideway_normal",
+                "--measured",
+            ])
+            .arg(&zx)
+            .arg("--out")
+            .arg(s.path("id.toml"))
+            .arg("--report")
+            .arg(s.path("id.json"))
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        (
+            std::fs::read(s.path("id.toml")).unwrap(),
+            std::fs::read(s.path("id.json")).unwrap(),
+        )
+    };
+    let one = run(&a, "1");
+    let two = run(&b, "2");
+    assert_eq!(one, two);
+}
+
+#[test]
+fn non_convergence_exports_nothing() {
+    let s = Scratch::new("iters");
+    let out = identify(&s, &["--max-iters", "1"]);
+    assert_failed_cleanly(&s, &out, "did not converge in 1 iterations");
+}
+
+#[test]
+fn parameter_at_its_bound_exports_nothing() {
+    let s = Scratch::new("bound");
+    std::fs::write(s.path("cfg.toml"), "min_factor = 0.6\n").unwrap();
+    let cfg = s.path("cfg.toml");
+    let out = identify(&s, &["--config", cfg.to_str().unwrap()]);
+    std::fs::remove_file(&cfg).unwrap();
+    assert_failed_cleanly(&s, &out, "z.guideway_normal ended at its bound 0.6");
+}
+
+#[test]
+fn unknown_parameter_and_missing_measurement() {
+    let s = Scratch::new("names");
+    let out = identify(&s, &["--param", "q.guideway"]);
+    assert_failed_cleanly(&s, &out, "parameter 'q.guideway': unknown axis 'q'");
+    let out = Command::new(env!("CARGO_BIN_EXE_eij"))
+        .current_dir(root())
+        .args([
+            "identify",
+            "--measured",
+            "measurements/nothing-here.csv",
+            "--out",
+        ])
+        .arg(s.path("id.toml"))
+        .arg("--report")
+        .arg(s.path("id.json"))
+        .output()
+        .unwrap();
+    assert_failed_cleanly(&s, &out, "measurements/nothing-here.csv: cannot read");
+}
+
+#[test]
+fn measured_plane_the_model_cannot_simulate() {
+    let s = Scratch::new("plane");
+    let out = Command::new(env!("CARGO_BIN_EXE_eij"))
+        .current_dir(root())
+        .args([
+            "identify",
+            "--machine",
+            "machines/reference/single-axis.toml",
+            "--param",
+            "x.guideway",
+            "--measured",
+            "measurements/demo-vmc/xy_ccw_4.csv",
+            "--out",
+        ])
+        .arg(s.path("id.toml"))
+        .arg("--report")
+        .arg(s.path("id.json"))
+        .output()
+        .unwrap();
+    assert_failed_cleanly(
+        &s,
+        &out,
+        "plane xy needs axis y, which the model single-axis does not have",
+    );
+}
