@@ -39,9 +39,9 @@ fn identify(s: &Scratch, extra: &[&str]) -> Output {
             "machines/demo-vmc.toml",
             "--measured",
         ])
-        .arg(zx("zx_ccw_4.csv"))
-        .arg(zx("zx_cw_6.csv"))
-        .arg(zx("zx_ccw_8.csv"))
+        .arg(zx("pos-a/zx_ccw_5.csv"))
+        .arg(zx("pos-a/zx_cw_8.csv"))
+        .arg(zx("pos-b/zx_ccw_8.csv"))
         .args([
             "--param",
             "z.guideway_normal",
@@ -121,7 +121,7 @@ fn reports_are_identical_across_runs_and_thread_counts() {
     let a = Scratch::new("det-a");
     let b = Scratch::new("det-b");
     let run = |s: &Scratch, threads: &str| {
-        let zx = root().join("measurements/demo-vmc/zx_ccw_4.csv");
+        let zx = root().join("measurements/demo-vmc/pos-a/zx_ccw_5.csv");
         let out = Command::new(env!("CARGO_BIN_EXE_eij"))
             .current_dir(root())
             .env("RAYON_NUM_THREADS", threads)
@@ -205,7 +205,7 @@ fn measured_plane_the_model_cannot_simulate() {
             "--param",
             "x.guideway",
             "--measured",
-            "measurements/demo-vmc/xy_ccw_4.csv",
+            "measurements/demo-vmc/pos-a/xy_ccw_5.csv",
             "--out",
         ])
         .arg(s.path("id.toml"))

@@ -159,7 +159,7 @@ fn negative_stiffness_and_reduction_factor() {
         &["axis[x].drive.nut_stiffness_n_per_um", "must be > 0"],
     );
     let t = demo_text().replace(
-        "stiffness_n_per_m = [1.0e8, 1.0e8, 2.5e8]",
+        "stiffness_n_per_m = [1.3e8, 1.3e8, 2.5e8]",
         "stiffness_n_per_m = [1.0e8, -1.0e8, 2.5e8]",
     );
     assert_one_line_error(

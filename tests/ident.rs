@@ -169,7 +169,7 @@ fn noisy_demo_set_recovers_the_generator_truth_within_three_standard_errors() {
     let tests =
         eij::ident::measured::load(&[root().join("measurements/demo-vmc")], &Default::default())
             .unwrap();
-    assert_eq!(tests.len(), 24);
+    assert_eq!(tests.len(), 36);
     let problem = Problem::new(
         machine.clone(),
         Parameter::default_set(&machine),

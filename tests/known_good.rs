@@ -29,7 +29,7 @@ fn a_drifted_value_fails_verify_with_one_line() {
     std::fs::write(
         &file,
         format!(
-            "description = \"z only, expected value off on purpose\"\nmachine = \"{root}/machines/demo-vmc.toml\"\nmeasured = [\"{root}/measurements/demo-vmc/zx_ccw_4.csv\", \"{root}/measurements/demo-vmc/zx_ccw_8.csv\", \"{root}/measurements/demo-vmc/zx_cw_6.csv\"]\n[settings]\nparameters = [\"z.guideway_normal\"]\n[expected.\"z.guideway_normal\"]\nvalue = 0.5\nrel_tol = 0.01\n"
+            "description = \"z only, expected value off on purpose\"\nmachine = \"{root}/machines/demo-vmc.toml\"\nmeasured = [\"{root}/measurements/demo-vmc/pos-a/zx_ccw_5.csv\", \"{root}/measurements/demo-vmc/pos-a/zx_ccw_8.csv\", \"{root}/measurements/demo-vmc/pos-b/zx_cw_5.csv\"]\n[settings]\nparameters = [\"z.guideway_normal\"]\n[expected.\"z.guideway_normal\"]\nvalue = 0.5\nrel_tol = 0.01\n"
         ),
     )
     .unwrap();

@@ -88,22 +88,33 @@ fn folder_conditions(dir: &Path) -> Result<FolderConditions, IdentError> {
     Ok(c)
 }
 
-/// Expands folders (their `*.csv`, sorted) and keeps files.
+/// The `*.csv` files of a folder and, recursively, of its sub-folders, sorted by path.
+fn folder_files(dir: &Path) -> Result<Vec<PathBuf>, IdentError> {
+    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(|e| IdentError::Test {
+            input: dir.display().to_string(),
+            message: format!("cannot read folder: {e}"),
+        })?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .collect();
+    entries.sort();
+    let mut files = Vec::new();
+    for e in entries {
+        if e.is_dir() {
+            files.extend(folder_files(&e)?);
+        } else if e.extension().is_some_and(|x| x.eq_ignore_ascii_case("csv")) {
+            files.push(e);
+        }
+    }
+    Ok(files)
+}
+
+/// Expands folders (their `*.csv`, sub-folders included, sorted) and keeps files.
 pub fn expand(paths: &[PathBuf]) -> Result<Vec<PathBuf>, IdentError> {
     let mut files = Vec::new();
     for p in paths {
         if p.is_dir() {
-            let mut inside: Vec<PathBuf> = std::fs::read_dir(p)
-                .map_err(|e| IdentError::Test {
-                    input: p.display().to_string(),
-                    message: format!("cannot read folder: {e}"),
-                })?
-                .filter_map(|e| e.ok().map(|e| e.path()))
-                .filter(|f| {
-                    f.is_file() && f.extension().is_some_and(|x| x.eq_ignore_ascii_case("csv"))
-                })
-                .collect();
-            inside.sort();
+            let inside = folder_files(p)?;
             if inside.is_empty() {
                 return Err(IdentError::Test {
                     input: p.display().to_string(),
@@ -119,20 +130,14 @@ pub fn expand(paths: &[PathBuf]) -> Result<Vec<PathBuf>, IdentError> {
 }
 
 /// Reads every path into test cases (R-Test series are evaluated; tables grouped by plane,
-/// direction and acceleration).
+/// direction and acceleration). Folders are read with their sub-folders; the optional
+/// `rtest.toml` beside the files states their set radius and circle-centre position.
 pub fn load(paths: &[PathBuf], opts: &MeasuredOptions) -> Result<Vec<TestCase>, IdentError> {
+    // The rtest.toml of a file's own folder states the conditions of that file.
     let mut tests = Vec::new();
-    for p in paths {
-        let conditions = if p.is_dir() {
-            folder_conditions(p)?
-        } else {
-            FolderConditions::default()
-        };
-        tests.extend(load_files(
-            &expand(std::slice::from_ref(p))?,
-            opts,
-            &conditions,
-        )?);
+    for f in expand(paths)? {
+        let conditions = folder_conditions(f.parent().unwrap_or(Path::new(".")))?;
+        tests.extend(load_files(std::slice::from_ref(&f), opts, &conditions)?);
     }
     Ok(tests)
 }
