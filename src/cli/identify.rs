@@ -224,6 +224,27 @@ fn print_result(prep: &Prepared, result: &IdentResult, seconds: f64) {
             );
         }
     }
+    let (mut before, mut after) = (Vec::new(), Vec::new());
+    for (i, t) in p.tests().iter().enumerate() {
+        for (e, (m, s)) in &t.measured {
+            if m.abs() > 3.0 * s {
+                before.push(result.simulated_initial[i][e] / m);
+                after.push(result.simulated_final[i][e] / m);
+            }
+        }
+    }
+    if !before.is_empty() {
+        let median = |v: &mut Vec<f64>| {
+            v.sort_by(f64::total_cmp);
+            v[v.len() / 2]
+        };
+        println!(
+            "\nsimulated/measured over the {} values beyond 3σ: median {:.2} with the catalogue model, {:.2} identified",
+            before.len(),
+            median(&mut before),
+            median(&mut after)
+        );
+    }
     for w in &result.warnings {
         println!("warning: {w}");
     }
