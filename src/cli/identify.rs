@@ -52,6 +52,10 @@ pub struct IdentifyArgs {
     /// Optimiser.
     #[arg(long, value_enum)]
     method: Option<Method>,
+    /// How the tests are simulated during the optimisation (the result is confirmed in the time
+    /// domain either way).
+    #[arg(long, value_enum)]
+    solver: Option<eij::ident::SolverKind>,
     /// Iteration limit.
     #[arg(long)]
     max_iters: Option<u64>,
@@ -258,6 +262,9 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
     };
     if let Some(m) = args.method {
         config.method = Some(m);
+    }
+    if let Some(m) = args.solver {
+        config.solver = Some(m);
     }
     if let Some(m) = args.max_iters {
         config.max_iters = Some(m);

@@ -13,6 +13,8 @@ use std::path::{Path, PathBuf};
 pub struct IdentConfig {
     /// Parameter names, e.g. `["x.guideway_normal", "z.screw"]`.
     pub parameters: Option<Vec<String>>,
+    /// `harmonic` (default) or `time`.
+    pub solver: Option<super::SolverKind>,
     /// `lm` or `nelder-mead`.
     pub method: Option<Method>,
     /// Iteration limit.
@@ -55,6 +57,9 @@ impl IdentConfig {
         };
         if let Some(v) = self.method {
             s.method = v;
+        }
+        if let Some(v) = self.solver {
+            s.solver = v;
         }
         if let Some(v) = self.max_iters {
             if v == 0 {

@@ -23,7 +23,7 @@ use crate::control::ClosedLoop;
 use crate::machine::Machine;
 use crate::rtest::{self, EvalOptions};
 use crate::sim::setpoint::Circle;
-use crate::sim::{output, simulate_discrete, Discrete};
+use crate::sim::{harmonic, output, simulate_discrete, Discrete};
 use argmin::core::observers::{Observe, ObserverMode};
 use argmin::core::{CostFunction, Executor, Jacobian, Operator, State, TerminationReason, KV};
 use nalgebra::{DMatrix, DVector};
@@ -209,6 +209,18 @@ impl TestCase {
     }
 }
 
+/// How a test is simulated.
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum,
+)]
+#[serde(rename_all = "kebab-case")]
+pub enum SolverKind {
+    /// Harmonic steady state (one complex solve per test; default).
+    Harmonic,
+    /// Time-domain simulation with ramps, exactly like `eij simulate circle`.
+    Time,
+}
+
 /// Which optimiser.
 #[derive(
     Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum,
@@ -246,6 +258,10 @@ pub struct Settings {
     pub sigma_floor: f64,
     /// Axis positions of the circle centre, m (machine axis order; `None`: reference position).
     pub position_m: Option<Vec<f64>>,
+    /// How the tests are simulated inside the optimisation (harmonic).
+    pub solver: SolverKind,
+    /// Samples per revolution of the harmonic steady state (128).
+    pub harmonic_samples_per_revolution: usize,
 }
 
 impl Settings {
@@ -279,6 +295,8 @@ impl Default for Settings {
             method: Method::Lm,
             sigma_floor: 1e-3,
             position_m: None,
+            solver: SolverKind::Harmonic,
+            harmonic_samples_per_revolution: 128,
         }
     }
 }
@@ -402,21 +420,40 @@ impl Problem {
             .join(", ")
     }
 
-    /// Simulates and evaluates one test on a prepared closed loop.
+    /// Simulates and evaluates one test on a prepared closed loop (`disc` for the time domain).
     fn run_test(
         &self,
         cl: &ClosedLoop,
-        disc: &Discrete,
+        disc: Option<&Discrete>,
         test: &TestCase,
     ) -> Result<EijMap, String> {
-        let mut circle = Circle::new(
-            test.plane,
-            test.radius_mm * 1e-3,
-            test.accel_m_s2,
-            test.direction,
-        );
-        circle.steady_revolutions = self.settings.revolutions;
-        let run = simulate_discrete(cl, disc, &circle).map_err(|e| e.to_string())?;
+        let run = match disc {
+            Some(disc) => {
+                let mut circle = Circle::new(
+                    test.plane,
+                    test.radius_mm * 1e-3,
+                    test.accel_m_s2,
+                    test.direction,
+                );
+                circle.steady_revolutions = self.settings.revolutions;
+                simulate_discrete(cl, disc, &circle).map_err(|e| e.to_string())?
+            }
+            None => {
+                let ph = harmonic::circle_phasors(
+                    cl,
+                    test.plane,
+                    test.radius_mm * 1e-3,
+                    test.accel_m_s2,
+                    test.direction,
+                )
+                .ok_or("the closed loop has a pole at the circle frequency")?;
+                harmonic::steady_circle(
+                    &ph,
+                    self.settings.harmonic_samples_per_revolution,
+                    self.settings.revolutions as usize,
+                )
+            }
+        };
         let series = output::to_series(cl, &run, test.label()).map_err(|e| e.to_string())?;
         let opts = EvalOptions {
             plane: Some(test.plane),
@@ -429,8 +466,17 @@ impl Problem {
     /// Simulated EIJ of every test for every parameter vector, in parallel over all
     /// (parameter vector, test) pairs; the order of the result does not depend on threads.
     pub fn simulate_many(&self, thetas: &[DVector<f64>]) -> Result<Vec<Vec<EijMap>>, IdentError> {
+        self.simulate_many_with(thetas, self.settings.solver)
+    }
+
+    /// As [`Problem::simulate_many`] with an explicit solver.
+    pub fn simulate_many_with(
+        &self,
+        thetas: &[DVector<f64>],
+        solver: SolverKind,
+    ) -> Result<Vec<Vec<EijMap>>, IdentError> {
         let np = self.poses.len();
-        let loops: Vec<Result<(ClosedLoop, Discrete), IdentError>> = (0..thetas.len() * np)
+        let loops: Vec<Result<(ClosedLoop, Option<Discrete>), IdentError>> = (0..thetas.len() * np)
             .into_par_iter()
             .map(|k| {
                 let theta = &thetas[k / np];
@@ -442,18 +488,20 @@ impl Problem {
                         message: e.to_string(),
                     }
                 })?;
-                let disc = Discrete::new(&cl, 1.0 / self.settings.rate_hz);
+                let disc = (solver == SolverKind::Time)
+                    .then(|| Discrete::new(&cl, 1.0 / self.settings.rate_hz));
                 Ok((cl, disc))
             })
             .collect();
-        let loops: Vec<(ClosedLoop, Discrete)> = loops.into_iter().collect::<Result<_, _>>()?;
+        let loops: Vec<(ClosedLoop, Option<Discrete>)> =
+            loops.into_iter().collect::<Result<_, _>>()?;
         let nt = self.tests.len();
         let flat: Vec<Result<EijMap, IdentError>> = (0..thetas.len() * nt)
             .into_par_iter()
             .map(|k| {
                 let (s, t) = (k / nt, k % nt);
                 let (cl, disc) = &loops[s * np + self.test_pose[t]];
-                self.run_test(cl, disc, &self.tests[t])
+                self.run_test(cl, disc.as_ref(), &self.tests[t])
                     .map_err(|message| IdentError::Simulation {
                         test: self.tests[t].label(),
                         params: self.describe(&thetas[s]),
@@ -686,6 +734,8 @@ pub struct IdentResult {
     pub simulated_initial: Vec<EijMap>,
     /// Simulated EIJ per test at the solution.
     pub simulated_final: Vec<EijMap>,
+    /// The same by the time-domain simulation (confirmation of a harmonic optimisation).
+    pub simulated_final_time: Option<Vec<EijMap>>,
     /// Warnings (non-identifiable parameters, near-singular combinations).
     pub warnings: Vec<String>,
     /// The identified machine.
@@ -882,6 +932,38 @@ pub fn identify(
         }
     }
     let sims = problem.simulate_many(&[theta0.clone(), theta.clone()])?;
+    // The final result is confirmed once in the time domain (when optimised harmonically).
+    let simulated_final_time = if s.solver == SolverKind::Harmonic {
+        let time = problem
+            .simulate_many_with(std::slice::from_ref(&theta), SolverKind::Time)?
+            .remove(0);
+        let mut worst = (0.0, String::new());
+        for (i, (h, t)) in sims[1].iter().zip(&time).enumerate() {
+            for (e, v) in h {
+                let d = (v - t[e]).abs();
+                let allowed = (0.01 * t[e].abs()).max(0.01);
+                if d / allowed > worst.0 {
+                    worst = (
+                        d / allowed,
+                        format!(
+                            "{} {e}: harmonic {v:.4}, time domain {:.4}",
+                            problem.tests[i].label(),
+                            t[e]
+                        ),
+                    );
+                }
+            }
+        }
+        if worst.0 > 1.0 {
+            warnings.push(format!(
+                "harmonic and time-domain EIJ disagree beyond 1 % / 0.01 µm·s²/m: {}",
+                worst.1
+            ));
+        }
+        Some(time)
+    } else {
+        None
+    };
     let cost_history = costs.lock().map(|c| c.clone()).unwrap_or_default();
     Ok(IdentResult {
         parameters,
@@ -895,6 +977,7 @@ pub fn identify(
         iterations,
         simulated_initial: sims[0].clone(),
         simulated_final: sims[1].clone(),
+        simulated_final_time,
         warnings,
         machine: problem.machine_at(&theta),
     })

@@ -34,7 +34,8 @@ impl Provenance {
 
 fn settings_json(s: &Settings) -> Value {
     json!({
-        "method": s.method,
+                "method": s.method,
+        "solver": s.solver,
         "rate_hz": s.rate_hz,
         "revolutions": s.revolutions,
         "min_factor": s.min_factor,
@@ -85,6 +86,7 @@ pub fn report_json(problem: &Problem, result: &IdentResult, prov: &Provenance) -
                 "measured_std_err": eij_json(&sigma),
                 "simulated_initial": only_measured(&result.simulated_initial[i]),
                 "simulated_final": only_measured(&result.simulated_final[i]),
+                "simulated_final_time_domain": result.simulated_final_time.as_ref().map(|t| only_measured(&t[i])),
                 "ratio_initial": ratio(&result.simulated_initial[i]),
                 "ratio_final": ratio(&result.simulated_final[i]),
             })

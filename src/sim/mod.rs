@@ -10,6 +10,7 @@
 //! Γ₀ = Γa − Γb,  Γ₁ = Γb.
 //! ```
 
+pub mod harmonic;
 pub mod output;
 pub mod setpoint;
 
