@@ -26,6 +26,7 @@ pub mod control;
 pub mod ident;
 pub mod io;
 pub mod machine;
+pub mod map;
 pub mod mbs;
 pub mod rtest;
 pub mod sim;

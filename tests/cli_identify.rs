@@ -227,11 +227,15 @@ fn time_domain_and_harmonic_identifications_agree() {
     assert!(identify(&h, &["--solver", "harmonic"]).status.success());
     assert!(identify(&t, &["--solver", "time"]).status.success());
     let value = |s: &Scratch, i: usize| -> f64 {
-        let json: serde_json::Value = serde_json::from_slice(&std::fs::read(s.path("id.json")).unwrap()).unwrap();
+        let json: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(s.path("id.json")).unwrap()).unwrap();
         json["parameters"][i]["identified"].as_f64().unwrap()
     };
     for i in 0..2 {
         let (a, b) = (value(&h, i), value(&t, i));
-        assert!((a / b - 1.0).abs() < 0.01, "parameter {i}: harmonic {a}, time {b}");
+        assert!(
+            (a / b - 1.0).abs() < 0.01,
+            "parameter {i}: harmonic {a}, time {b}"
+        );
     }
 }

@@ -6,6 +6,7 @@ pub mod evaluate;
 mod export;
 mod identify;
 mod machine_args;
+mod map;
 mod modal;
 mod simulate;
 
@@ -31,6 +32,8 @@ enum Command {
     Identify(identify::IdentifyArgs),
     /// Re-run stored known-good identifications and fail if a result drifts.
     Verify(identify::VerifyArgs),
+    /// EIJ over a grid of axis positions (compensation table).
+    Map(map::MapArgs),
 }
 
 impl Cli {
@@ -43,6 +46,7 @@ impl Cli {
             Command::Export(args) => export::run(args),
             Command::Identify(args) => identify::run(args),
             Command::Verify(args) => identify::verify(args),
+            Command::Map(args) => map::run(args),
         }
     }
 }

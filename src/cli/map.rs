@@ -1,0 +1,74 @@
+//! `eij map`: EIJ over a grid of axis positions, as a compensation table.
+
+use super::machine_args::write_output;
+use anyhow::bail;
+use eij::axes::{Direction, Plane};
+use eij::machine::Machine;
+use eij::map::{eij_map, to_csv, AxisGrid, MapSpec};
+use std::path::PathBuf;
+
+/// Arguments of `eij map`.
+#[derive(Debug, clap::Args)]
+pub struct MapArgs {
+    /// Machine description.
+    #[arg(long, value_name = "FILE.toml")]
+    machine: PathBuf,
+    /// Plane of the circle: xy, yz or zx.
+    #[arg(long)]
+    plane: Plane,
+    /// cw or ccw.
+    #[arg(long, default_value = "ccw")]
+    direction: Direction,
+    /// Circle radius, mm.
+    #[arg(long, default_value_t = 2.0)]
+    radius_mm: f64,
+    /// Set acceleration, m/s².
+    #[arg(long)]
+    accel_m_s2: f64,
+    /// Grid of one axis, `<axis>=<min>:<max>:<count>` in mm (repeatable; other axes stay at their
+    /// reference position).
+    #[arg(
+        long = "grid",
+        value_name = "AXIS=MIN:MAX:N",
+        required = true,
+        allow_hyphen_values = true
+    )]
+    grids: Vec<String>,
+    /// Output CSV (compensation table).
+    #[arg(long, value_name = "FILE.csv")]
+    out: PathBuf,
+}
+
+/// Runs `eij map`.
+pub fn run(args: MapArgs) -> anyhow::Result<()> {
+    if !(args.radius_mm.is_finite() && args.radius_mm > 0.0 && args.radius_mm <= 3.0) {
+        bail!(
+            "--radius-mm: {} must lie in (0, 3] mm (R-Test range)",
+            args.radius_mm
+        );
+    }
+    if !(args.accel_m_s2.is_finite() && args.accel_m_s2 > 0.0) {
+        bail!(
+            "--accel-m-s2: {} must be a positive number",
+            args.accel_m_s2
+        );
+    }
+    let machine = Machine::from_file(&args.machine)?;
+    let grids = args
+        .grids
+        .iter()
+        .map(|g| AxisGrid::parse(g))
+        .collect::<Result<Vec<_>, _>>()?;
+    let spec = MapSpec {
+        plane: args.plane,
+        direction: args.direction,
+        radius_m: args.radius_mm * 1e-3,
+        accel_m_s2: args.accel_m_s2,
+    };
+    let points = eij_map(&machine, &grids, &spec)?;
+    write_output(
+        &args.out,
+        to_csv(&machine, &spec, &points).as_bytes(),
+        &[&args.machine],
+    )
+}

@@ -1,0 +1,215 @@
+//! EIJ maps over the workspace: the position-dependent model evaluated on a grid of axis
+//! positions (harmonic steady state, the same evaluation as measured data), as a compensation
+//! table position → EIJ.
+
+use crate::axes::{Axis, Direction, Eij, Plane};
+use crate::control::ClosedLoop;
+use crate::machine::Machine;
+use crate::rtest::{self, EvalOptions};
+use crate::sim::{harmonic, output};
+use rayon::prelude::*;
+use std::collections::BTreeMap;
+
+/// Errors of a map.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MapError {
+    /// A grid that does not fit the machine.
+    #[error("--grid {spec}: {message}")]
+    Grid {
+        /// The grid specification given.
+        spec: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A grid point the model cannot be evaluated at.
+    #[error("at {position}: {message}")]
+    Point {
+        /// The position, mm.
+        position: String,
+        /// What failed.
+        message: String,
+    },
+}
+
+/// Grid values of one axis: `min:max:count` in mm (count ≥ 1; count 1 takes `min`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct AxisGrid {
+    /// The axis.
+    pub axis: Axis,
+    /// Positions, m.
+    pub values_m: Vec<f64>,
+}
+
+impl AxisGrid {
+    /// Parses `x=-250:250:5` (mm).
+    pub fn parse(spec: &str) -> Result<AxisGrid, MapError> {
+        let bad = |m: &str| MapError::Grid {
+            spec: spec.to_string(),
+            message: m.to_string(),
+        };
+        let (axis, range) = spec
+            .split_once('=')
+            .ok_or_else(|| bad("expected <axis>=<min>:<max>:<count>, e.g. x=-250:250:5 (mm)"))?;
+        let axis: Axis = axis.trim().parse().map_err(|m: String| bad(&m))?;
+        let parts: Vec<&str> = range.split(':').collect();
+        if parts.len() != 3 {
+            return Err(bad("expected <min>:<max>:<count>"));
+        }
+        let lo: f64 = parts[0]
+            .trim()
+            .parse()
+            .map_err(|_| bad("min is not a number"))?;
+        let hi: f64 = parts[1]
+            .trim()
+            .parse()
+            .map_err(|_| bad("max is not a number"))?;
+        let n: usize = parts[2]
+            .trim()
+            .parse()
+            .map_err(|_| bad("count is not a whole number"))?;
+        if !(lo.is_finite() && hi.is_finite()) || n == 0 || (n > 1 && hi <= lo) {
+            return Err(bad("need finite min < max and count ≥ 1"));
+        }
+        let values_m = (0..n)
+            .map(|i| if n == 1 { lo } else { lo + (hi - lo) * i as f64 / (n - 1) as f64 } * 1e-3)
+            .collect();
+        Ok(AxisGrid { axis, values_m })
+    }
+}
+
+/// The circle evaluated at every grid point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MapSpec {
+    /// Plane.
+    pub plane: Plane,
+    /// Direction.
+    pub direction: Direction,
+    /// Radius, m.
+    pub radius_m: f64,
+    /// Set acceleration, m/s².
+    pub accel_m_s2: f64,
+}
+
+/// One grid point of a map.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MapPoint {
+    /// Axis positions in machine axis order, m.
+    pub position_m: Vec<f64>,
+    /// The six EIJ of the plane, µm·s²/m.
+    pub eij: BTreeMap<Eij, f64>,
+}
+
+/// EIJ over the grid (axes without a grid stay at their reference position), in parallel;
+/// points in row-major order of the grids as given.
+pub fn eij_map(
+    machine: &Machine,
+    grids: &[AxisGrid],
+    spec: &MapSpec,
+) -> Result<Vec<MapPoint>, MapError> {
+    let mut index = Vec::new();
+    for g in grids {
+        let i = machine
+            .axes
+            .iter()
+            .position(|a| a.axis == g.axis)
+            .ok_or_else(|| MapError::Grid {
+                spec: g.axis.to_string(),
+                message: format!("the machine {} has no axis {}", machine.name, g.axis),
+            })?;
+        if index.contains(&i) {
+            return Err(MapError::Grid {
+                spec: g.axis.to_string(),
+                message: "axis given twice".into(),
+            });
+        }
+        let [lo, hi] = machine.axes[i].stroke_m;
+        if g.values_m.iter().any(|v| *v < lo || *v > hi) {
+            return Err(MapError::Grid {
+                spec: g.axis.to_string(),
+                message: format!("outside the stroke [{}, {}] mm", lo * 1e3, hi * 1e3),
+            });
+        }
+        index.push(i);
+    }
+    let mut positions = vec![machine.reference_pose()];
+    for (g, &i) in grids.iter().zip(&index) {
+        positions = positions
+            .into_iter()
+            .flat_map(|p| {
+                g.values_m.iter().map(move |v| {
+                    let mut q = p.clone();
+                    q[i] = *v;
+                    q
+                })
+            })
+            .collect();
+    }
+    positions
+        .into_par_iter()
+        .map(|position_m| {
+            let err = |m: String| MapError::Point {
+                position: position_m
+                    .iter()
+                    .map(|v| format!("{:.1}", v * 1e3))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+                    + " mm",
+                message: m,
+            };
+            let cl = ClosedLoop::new(machine, &position_m).map_err(|e| err(e.to_string()))?;
+            let ph = harmonic::circle_phasors(
+                &cl,
+                spec.plane,
+                spec.radius_m,
+                spec.accel_m_s2,
+                spec.direction,
+            )
+            .ok_or_else(|| err("closed-loop pole at the circle frequency".into()))?;
+            let run = harmonic::steady_circle(&ph, 128, 3);
+            let series =
+                output::to_series(&cl, &run, "map".into()).map_err(|e| err(e.to_string()))?;
+            let opts = EvalOptions {
+                plane: Some(spec.plane),
+                radius_mm: Some(spec.radius_m * 1e3),
+            };
+            let (_, joint) =
+                rtest::evaluate_joint(&series, &opts).map_err(|e| err(e.to_string()))?;
+            Ok(MapPoint {
+                position_m,
+                eij: joint.eij,
+            })
+        })
+        .collect()
+}
+
+/// The compensation table as CSV: `x_mm,y_mm,z_mm,plane,direction,radius_mm,accel_m_s2`, then
+/// one `<EIJ>_um_s2_per_m` column per parameter of the plane.
+pub fn to_csv(machine: &Machine, spec: &MapSpec, points: &[MapPoint]) -> String {
+    let params = spec.plane.parameters();
+    let mut out = String::from("x_mm,y_mm,z_mm,plane,direction,radius_mm,accel_m_s2");
+    for p in &params {
+        out.push_str(&format!(",{p}_um_s2_per_m"));
+    }
+    out.push('\n');
+    for pt in points {
+        let mut xyz = [0.0; 3];
+        for (a, v) in machine.axes.iter().zip(&pt.position_m) {
+            xyz[a.axis.index()] = v * 1e3;
+        }
+        out.push_str(&format!(
+            "{:.3},{:.3},{:.3},{},{},{},{}",
+            xyz[0],
+            xyz[1],
+            xyz[2],
+            spec.plane,
+            spec.direction,
+            spec.radius_m * 1e3,
+            spec.accel_m_s2
+        ));
+        for p in &params {
+            out.push_str(&format!(",{:.6}", pt.eij[p]));
+        }
+        out.push('\n');
+    }
+    out
+}
