@@ -27,5 +27,6 @@ pub mod ident;
 pub mod io;
 pub mod machine;
 pub mod mbs;
+pub mod report;
 pub mod rtest;
 pub mod sim;

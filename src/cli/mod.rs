@@ -7,6 +7,7 @@ mod export;
 mod identify;
 mod machine_args;
 mod modal;
+mod report;
 mod simulate;
 
 /// eij — acceleration correlated position errors of machine tools from R-Test circle tests.
@@ -31,6 +32,8 @@ enum Command {
     Identify(identify::IdentifyArgs),
     /// Re-run stored known-good identifications and fail if a result drifts.
     Verify(identify::VerifyArgs),
+    /// Write an offline HTML report with SVG figures (circle tests, moves, identification).
+    Report(report::ReportArgs),
 }
 
 impl Cli {
@@ -43,6 +46,7 @@ impl Cli {
             Command::Export(args) => export::run(args),
             Command::Identify(args) => identify::run(args),
             Command::Verify(args) => identify::verify(args),
+            Command::Report(args) => report::run(args),
         }
     }
 }
