@@ -320,8 +320,7 @@ th,td{border:1px solid #ccc;padding:3px 7px;text-align:right;white-space:nowrap}
 th{background:#f0f0f0}td.l,th.l{text-align:left}\
 figure{margin:8px 0 24px 0}figcaption{font-size:13px;color:#444}\
 img{max-width:100%;height:auto;border:1px solid #ddd}\
-.pair{display:flex;flex-wrap:wrap;gap:12px;align-items:flex-start}\
-.pair figure{flex:1 1 600px;max-width:740px}.warn{color:#a33;font-size:13px}\
+.warn{color:#a33;font-size:13px}\
 p.note{font-size:13px;color:#444}";
 
 fn figure_html(h: &mut String, f: &Figure) {
@@ -374,9 +373,9 @@ fn page(
         let _ = writeln!(h, "<h2>Circle tests: figures</h2>");
         let _ = writeln!(
             h,
-            "<p class=\"note\">Left: set circle, internal and external paths over the steady \
+            "<p class=\"note\">Per test: first the set circle, internal and external paths over the steady \
              revolutions with radial deviations magnified (drawn radius r + M·(ρ − r)) and the \
-             fitted ellipses (paper Fig. 5, 8). Right: out-of-plane deviation over the phase \
+             fitted ellipses (paper Fig. 5, 8), then the out-of-plane deviation over the phase \
              with the fitted plane (paper Fig. 4, 7).</p>"
         );
         for (i, c) in circles.iter().enumerate() {
@@ -390,10 +389,8 @@ fn page(
             for w in &c.result.warnings {
                 let _ = writeln!(h, "<p class=\"warn\">warning: {}</p>", escape(w));
             }
-            let _ = writeln!(h, "<div class=\"pair\">");
             figure_html(&mut h, &c.circle);
             figure_html(&mut h, &c.out_of_plane);
-            let _ = writeln!(h, "</div>");
         }
     }
     if !moves.is_empty() {

@@ -253,6 +253,15 @@ pub fn identification_svg(report: &Value) -> Result<String, ReportError> {
         short(rep.cost_final, 4),
         rep.cost_history.len().saturating_sub(1)
     )];
+    if let Some(h0) = rep.cost_history.first() {
+        if (h0 - rep.cost_initial).abs() > 0.01 * rep.cost_initial.abs() {
+            lines.push(format!(
+                "note: the cost history starts at {} (cost_history[0]), not at cost_initial = {}",
+                short(*h0, 4),
+                short(rep.cost_initial, 4)
+            ));
+        }
+    }
     if let Some(m) = &rep.machine {
         lines.push(format!(
             "machine: {m}  ·  tests labelled plane, direction, set acceleration / (m/s²)"
