@@ -28,5 +28,6 @@ pub mod io;
 pub mod machine;
 pub mod map;
 pub mod mbs;
+pub mod report;
 pub mod rtest;
 pub mod sim;

@@ -30,6 +30,10 @@ pub struct EvaluateArgs {
     /// at different accelerations of one plane).
     #[arg(long)]
     pub pooled: bool,
+    /// Also write the magnified circle plot (SVG) of the test; takes exactly one file (for
+    /// several, use `eij report`).
+    #[arg(long, value_name = "FILE.svg")]
+    pub plot: Option<PathBuf>,
 }
 
 /// Runs `eij evaluate`.
@@ -38,6 +42,12 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<()> {
         if !(r.is_finite() && r > 0.0) {
             anyhow::bail!("--radius-mm {r}: expected a positive number of mm");
         }
+    }
+    if args.plot.is_some() && args.files.len() != 1 {
+        anyhow::bail!(
+            "--plot: {} files given, a plot shows one test (use `eij report` for several)",
+            args.files.len()
+        );
     }
     let opts = EvalOptions {
         plane: args.plane,
@@ -58,10 +68,21 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<()> {
     } else {
         None
     };
+    let plot_svg = match &args.plot {
+        Some(_) => {
+            let cond = eij::report::Conditions::of_file(&args.files[0])?;
+            Some(eij::report::CircleView::new(&series[0], &opts)?.magnified_svg(&cond)?)
+        }
+        None => None,
+    };
     if let Some(out) = &args.csv_out {
         let rows: Vec<_> = results.iter().flat_map(table::rows_from_result).collect();
         let inputs: Vec<&Path> = args.files.iter().map(PathBuf::as_path).collect();
         table::write(out, &rows, &inputs)?;
+    }
+    if let (Some(plot), Some(svg)) = (&args.plot, plot_svg) {
+        let inputs: Vec<&Path> = args.files.iter().map(PathBuf::as_path).collect();
+        eij::io::write_atomic(plot, svg.as_bytes(), &inputs)?;
     }
     if args.json {
         let mut doc = serde_json::Map::new();

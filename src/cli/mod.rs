@@ -8,6 +8,7 @@ mod identify;
 mod machine_args;
 mod map;
 mod modal;
+mod report;
 mod simulate;
 
 /// eij — acceleration correlated position errors of machine tools from R-Test circle tests.
@@ -34,6 +35,8 @@ enum Command {
     Verify(identify::VerifyArgs),
     /// EIJ over a grid of axis positions (compensation table).
     Map(map::MapArgs),
+    /// Write an offline HTML report with SVG figures (circle tests, moves, identification).
+    Report(report::ReportArgs),
 }
 
 impl Cli {
@@ -47,6 +50,7 @@ impl Cli {
             Command::Identify(args) => identify::run(args),
             Command::Verify(args) => identify::verify(args),
             Command::Map(args) => map::run(args),
+            Command::Report(args) => report::run(args),
         }
     }
 }

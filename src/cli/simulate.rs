@@ -4,6 +4,9 @@ use super::machine_args::{write_output, MachineArgs};
 use anyhow::bail;
 use eij::axes::{Axis, Direction, Plane};
 use eij::control::ClosedLoop;
+use eij::machine::Machine;
+use eij::report::{move_svg, CircleView, Conditions, MoveData};
+use eij::rtest::EvalOptions;
 use eij::sim::setpoint::{Circle, JerkLimitedMove, SetPoint};
 use eij::sim::{output, simulate};
 use std::path::PathBuf;
@@ -47,6 +50,16 @@ struct Common {
     /// Decimals of every number in the CSV.
     #[arg(long, default_value_t = 10)]
     decimals: usize,
+    /// Also write a figure (SVG): the magnified circle plot of the noise-free simulated
+    /// series, or the move plot (position, acceleration, cross-talk over time).
+    #[arg(long, value_name = "FILE.svg")]
+    plot: Option<PathBuf>,
+}
+
+/// What `--plot` draws.
+enum PlotKind {
+    Circle { radius_mm: f64 },
+    Move(Axis),
 }
 
 #[derive(Debug, clap::Args)]
@@ -113,7 +126,7 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
             }
             let mut circle = Circle::new(c.plane, radius_mm * 1e-3, accel, c.direction);
             circle.steady_revolutions = c.revolutions;
-            run_setpoint(&c.common, &circle, Some(c.plane))
+            run_setpoint(&c.common, &circle, c.plane, radius_mm)
         }
         Test::Move(m) => {
             if !(m.distance_mm.is_finite() && m.distance_mm != 0.0) {
@@ -156,27 +169,50 @@ fn run_move(common: &Common, mv: &JerkLimitedMove) -> anyhow::Result<()> {
     let mut mid = pose.clone();
     mid[i] += mv.distance_m / 2.0;
     let cl = ClosedLoop::new(&machine, &mid)?;
-    write_run(common, &cl, mv)
+    let cond = conditions(common, &machine, &pose);
+    write_run(common, &cl, mv, PlotKind::Move(mv.axis), cond)
 }
 
-fn run_setpoint(common: &Common, sp: &dyn SetPoint, plane: Option<Plane>) -> anyhow::Result<()> {
+fn run_setpoint(
+    common: &Common,
+    sp: &dyn SetPoint,
+    plane: Plane,
+    radius_mm: f64,
+) -> anyhow::Result<()> {
     let (machine, pose) = common.machine.load()?;
-    if let Some(p) = plane {
-        let (a, b) = p.axes();
-        for ax in [a, b] {
-            if machine.axis(ax).is_none() {
-                bail!(
-                    "{}: the machine has no axis {ax}, cannot run a circle in plane {p}",
-                    machine.source
-                );
-            }
+    let (a, b) = plane.axes();
+    for ax in [a, b] {
+        if machine.axis(ax).is_none() {
+            bail!(
+                "{}: the machine has no axis {ax}, cannot run a circle in plane {plane}",
+                machine.source
+            );
         }
     }
     let cl = ClosedLoop::new(&machine, &pose)?;
-    write_run(common, &cl, sp)
+    let cond = conditions(common, &machine, &pose);
+    write_run(common, &cl, sp, PlotKind::Circle { radius_mm }, cond)
 }
 
-fn write_run(common: &Common, cl: &ClosedLoop, sp: &dyn SetPoint) -> anyhow::Result<()> {
+fn conditions(common: &Common, machine: &Machine, pose: &[f64]) -> Conditions {
+    Conditions {
+        source: format!("simulated ({})", common.out.display()),
+        machine: Some(format!(
+            "{} ({})",
+            machine.name,
+            common.machine.machine.display()
+        )),
+        position_mm: Some(pose.iter().map(|p| p * 1e3).collect()),
+    }
+}
+
+fn write_run(
+    common: &Common,
+    cl: &ClosedLoop,
+    sp: &dyn SetPoint,
+    kind: PlotKind,
+    cond: Conditions,
+) -> anyhow::Result<()> {
     let rate = positive("rate-hz", common.rate_hz)?;
     if !(common.noise_um.is_finite() && common.noise_um >= 0.0) {
         bail!("--noise-um: {} must be ≥ 0", common.noise_um);
@@ -189,5 +225,28 @@ fn write_run(common: &Common, cl: &ClosedLoop, sp: &dyn SetPoint) -> anyhow::Res
         seed: common.seed,
     };
     let bytes = output::to_csv(cl, &run, &opts);
-    write_output(&common.out, &bytes, &[&common.machine.machine])
+    let plot = match (&common.plot, kind) {
+        (None, _) => None,
+        (Some(path), PlotKind::Circle { radius_mm }) => {
+            let series = output::to_series(cl, &run, cond.source.clone())?;
+            let eval = EvalOptions {
+                plane: None,
+                radius_mm: Some(radius_mm),
+            };
+            Some((path, CircleView::new(&series, &eval)?.magnified_svg(&cond)?))
+        }
+        (Some(path), PlotKind::Move(axis)) => {
+            let data = MoveData::from_run(cl, &run, axis, cond.source.clone())?;
+            Some((path, move_svg(&data, &cond)?))
+        }
+    };
+    write_output(&common.out, &bytes, &[&common.machine.machine])?;
+    if let Some((path, svg)) = plot {
+        write_output(
+            path,
+            svg.as_bytes(),
+            &[&common.machine.machine, &common.out],
+        )?;
+    }
+    Ok(())
 }

@@ -1,0 +1,188 @@
+//! Figures and reports from eij's own data: SVG plots (plotters, SVG backend only) and an
+//! offline HTML report folder.
+//!
+//! ```text
+//! CircleSeries ─► CircleView ─► magnified_svg      (paper Fig. 5, 8: paths, set circle, ellipses)
+//!                            └► out_of_plane_svg  (paper Fig. 4, 7: d_k over φ, fitted plane)
+//! move CSV / sim::Run ─► MoveData ─► move_svg      (paper Fig. 9: position, acceleration, cross-talk)
+//! identify report JSON ─► identification_svg        (measured vs simulated EIJ, cost history)
+//! all of it ─► html::generate ─► DIR/report.html + DIR/*.svg
+//! ```
+//!
+//! Every figure states its conditions (source, machine where known, plane, radius, direction,
+//! acceleration, frequency, magnification, position where known) and units on its axes.
+//! Series colours are the public constants of [`svg`], so that tests and scripts can find a
+//! series in the SVG by its stroke or fill colour.
+//!
+//! EIJ maps over the workspace are not drawn here yet: they enter a report as further
+//! [`html::Figure`]s through [`html::ReportRequest::extra_figures`].
+
+use std::path::{Path, PathBuf};
+
+pub mod circle;
+pub mod html;
+pub mod ident_plot;
+pub mod move_plot;
+pub mod svg;
+
+pub use circle::CircleView;
+pub use html::{generate, ReportRequest};
+pub use ident_plot::identification_svg;
+pub use move_plot::{move_svg, MoveData};
+
+/// Errors of the figures and the report; every message is one line naming the file or key.
+#[derive(Debug, thiserror::Error)]
+pub enum ReportError {
+    /// Reading or evaluating a circle test failed.
+    #[error(transparent)]
+    Rtest(#[from] crate::rtest::RtestError),
+    /// A file could not be read.
+    #[error("{path}: {message}")]
+    Read {
+        /// The file.
+        path: String,
+        /// What went wrong.
+        message: String,
+    },
+    /// A file holds something unusable (missing column, bad number, ...).
+    #[error("{source_name}: {message}")]
+    BadInput {
+        /// The file (with line where one applies) or in-memory name.
+        source_name: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// The identification report lacks a key or holds a value of the wrong kind.
+    #[error("identification report: key `{key}`: {message}")]
+    Key {
+        /// JSON path of the key, e.g. `tests[3].measured`.
+        key: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// Drawing failed (plotters).
+    #[error("drawing {figure}: {message}")]
+    Plot {
+        /// Which figure.
+        figure: String,
+        /// The drawing error.
+        message: String,
+    },
+    /// The output folder cannot be used.
+    #[error("{path}: {message}")]
+    Output {
+        /// The folder.
+        path: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// Writing an output file failed.
+    #[error(transparent)]
+    Write(#[from] crate::io::WriteError),
+}
+
+/// What is known about where and on what a test ran, for titles and captions.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Conditions {
+    /// File path or in-memory name of the data.
+    pub source: String,
+    /// Machine name or file, where known.
+    pub machine: Option<String>,
+    /// Axis positions of the circle centre or move start, mm, in the machine's axis order.
+    pub position_mm: Option<Vec<f64>>,
+}
+
+/// `rtest.toml` next to a measured file: the folder's test conditions (as read by
+/// `eij identify`).
+#[derive(Debug, Clone, Default, PartialEq, serde::Deserialize)]
+pub struct FolderConditions {
+    /// Set radius, mm.
+    pub radius_mm: Option<f64>,
+    /// Axis positions of the circle centre, mm.
+    pub position_mm: Option<Vec<f64>>,
+}
+
+/// Name of the per-folder conditions file.
+pub const CONDITIONS_FILE: &str = "rtest.toml";
+
+impl FolderConditions {
+    /// Reads `rtest.toml` in the folder of `file`; absent file → no conditions.
+    pub fn of_file(file: &Path) -> Result<Self, ReportError> {
+        let dir = match file.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        let path = dir.join(CONDITIONS_FILE);
+        if !path.is_file() {
+            return Ok(FolderConditions::default());
+        }
+        let name = path.display().to_string();
+        let text = std::fs::read_to_string(&path).map_err(|e| ReportError::Read {
+            path: name.clone(),
+            message: e.to_string(),
+        })?;
+        let c: FolderConditions = toml::from_str(&text).map_err(|e| ReportError::BadInput {
+            source_name: name.clone(),
+            message: e.message().trim().replace('\n', " "),
+        })?;
+        if c.radius_mm.is_some_and(|r| !(r.is_finite() && r > 0.0)) {
+            return Err(ReportError::BadInput {
+                source_name: name,
+                message: "radius_mm must be a positive number of mm".into(),
+            });
+        }
+        if c.position_mm
+            .as_ref()
+            .is_some_and(|p| p.iter().any(|v| !v.is_finite()))
+        {
+            return Err(ReportError::BadInput {
+                source_name: name,
+                message: "position_mm must be finite".into(),
+            });
+        }
+        Ok(c)
+    }
+}
+
+impl Conditions {
+    /// Conditions of a measured file: its path and the position from its folder's
+    /// `rtest.toml`, if any.
+    pub fn of_file(file: &Path) -> Result<Self, ReportError> {
+        Ok(Conditions {
+            source: file.display().to_string(),
+            machine: None,
+            position_mm: FolderConditions::of_file(file)?.position_mm,
+        })
+    }
+
+    /// One caption line: source, machine and position where known.
+    pub fn line(&self, position_of: &str) -> String {
+        let mut parts = vec![format!("source: {}", self.source)];
+        if let Some(m) = &self.machine {
+            parts.push(format!("machine: {m}"));
+        }
+        if let Some(p) = &self.position_mm {
+            let p: Vec<String> = p.iter().map(|v| format!("{v:.1}")).collect();
+            parts.push(format!(
+                "{position_of} at axis positions [{}] mm",
+                p.join(", ")
+            ));
+        }
+        parts.join("  ·  ")
+    }
+}
+
+/// A number in a short form for titles: up to `max_decimals`, trailing zeros dropped.
+pub(crate) fn short(v: f64, max_decimals: usize) -> String {
+    let s = format!("{v:.max_decimals$}");
+    let s = if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    };
+    if s == "-0" {
+        "0".into()
+    } else {
+        s
+    }
+}
