@@ -2,6 +2,7 @@
 //! them, or EIJ tables (CONTRACT.md).
 
 use super::{IdentError, TestCase};
+use crate::rtest::conditions::TestConditions;
 use crate::rtest::{self, table, CircleSeries, EvalOptions};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -39,53 +40,6 @@ fn is_table(path: &Path) -> bool {
             )
         })
         .unwrap_or(false)
-}
-
-/// Conditions of the R-Test files of one folder, from its optional `rtest.toml`.
-#[derive(Debug, Clone, Default, PartialEq, serde::Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct FolderConditions {
-    /// Set radius of the circles, mm.
-    pub radius_mm: Option<f64>,
-    /// Axis positions of the circle centre, mm (machine axis order).
-    pub position_mm: Option<Vec<f64>>,
-}
-
-/// The file of a folder that states its test conditions.
-pub const CONDITIONS_FILE: &str = "rtest.toml";
-
-fn folder_conditions(dir: &Path) -> Result<FolderConditions, IdentError> {
-    let file = dir.join(CONDITIONS_FILE);
-    if !file.is_file() {
-        return Ok(FolderConditions::default());
-    }
-    let name = file.display().to_string();
-    let text = std::fs::read_to_string(&file).map_err(|e| IdentError::Test {
-        input: name.clone(),
-        message: format!("cannot read: {e}"),
-    })?;
-    let c: FolderConditions = toml::from_str(&text).map_err(|e| IdentError::Test {
-        input: name.clone(),
-        message: e.message().trim().replace('\n', " "),
-    })?;
-    if let Some(r) = c.radius_mm {
-        if !(r.is_finite() && r > 0.0 && r <= 3.0) {
-            return Err(IdentError::Test {
-                input: name,
-                message: format!("radius_mm = {r} must lie in (0, 3] mm"),
-            });
-        }
-    }
-    if c.position_mm
-        .as_ref()
-        .is_some_and(|p| p.iter().any(|v| !v.is_finite()))
-    {
-        return Err(IdentError::Test {
-            input: name,
-            message: "position_mm must be finite".into(),
-        });
-    }
-    Ok(c)
 }
 
 /// The `*.csv` files of a folder and, recursively, of its sub-folders, sorted by path.
@@ -136,7 +90,7 @@ pub fn load(paths: &[PathBuf], opts: &MeasuredOptions) -> Result<Vec<TestCase>, 
     // The rtest.toml of a file's own folder states the conditions of that file.
     let mut tests = Vec::new();
     for f in expand(paths)? {
-        let conditions = folder_conditions(f.parent().unwrap_or(Path::new(".")))?;
+        let conditions = TestConditions::of_file(&f)?;
         tests.extend(load_files(std::slice::from_ref(&f), opts, &conditions)?);
     }
     Ok(tests)
@@ -145,7 +99,7 @@ pub fn load(paths: &[PathBuf], opts: &MeasuredOptions) -> Result<Vec<TestCase>, 
 fn load_files(
     files: &[PathBuf],
     opts: &MeasuredOptions,
-    cond: &FolderConditions,
+    cond: &TestConditions,
 ) -> Result<Vec<TestCase>, IdentError> {
     let radius_mm = cond.radius_mm.unwrap_or(opts.radius_mm);
     let position_m = cond
@@ -155,10 +109,7 @@ fn load_files(
     let mut tests = Vec::new();
     for f in files {
         let name = f.display().to_string();
-        let err = |e: rtest::RtestError| IdentError::Test {
-            input: name.clone(),
-            message: e.to_string(),
-        };
+        let err = IdentError::Rtest;
         if is_table(f) {
             let rows = table::read(f).map_err(err)?;
             let mut groups: BTreeMap<(String, String, u64), TestCase> = BTreeMap::new();

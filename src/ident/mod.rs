@@ -50,6 +50,9 @@ pub enum IdentError {
         /// What is wrong.
         message: String,
     },
+    /// Reading or evaluating measured data (the message names file and line).
+    #[error(transparent)]
+    Rtest(#[from] crate::rtest::RtestError),
     /// Nothing to fit.
     #[error("{0}")]
     NoData(String),

@@ -14,11 +14,9 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use super::ident_plot::IdentReport;
-use super::{
-    identification_svg, move_svg, short, CircleView, Conditions, FolderConditions, MoveData,
-    ReportError,
-};
+use super::{identification_svg, move_svg, short, CircleView, Conditions, MoveData, ReportError};
 use crate::axes::Plane;
+use crate::rtest::conditions::TestConditions;
 use crate::rtest::{self, CircleResult, CircleSeries, EvalOptions};
 
 /// The report page's file name.
@@ -144,7 +142,7 @@ pub fn fmt_eij(v: f64) -> String {
 }
 
 fn evaluate_file(path: &Path, index: usize) -> Result<CircleEntry, ReportError> {
-    let folder = FolderConditions::of_file(path)?;
+    let folder = TestConditions::of_file(path)?;
     let opts = EvalOptions {
         plane: None,
         radius_mm: folder.radius_mm,

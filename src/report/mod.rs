@@ -17,7 +17,8 @@
 //! EIJ maps over the workspace are not drawn here yet: they enter a report as further
 //! [`html::Figure`]s through [`html::ReportRequest::extra_figures`].
 
-use std::path::{Path, PathBuf};
+use crate::rtest::conditions::TestConditions;
+use std::path::Path;
 
 pub mod circle;
 pub mod html;
@@ -92,58 +93,6 @@ pub struct Conditions {
     pub position_mm: Option<Vec<f64>>,
 }
 
-/// `rtest.toml` next to a measured file: the folder's test conditions (as read by
-/// `eij identify`).
-#[derive(Debug, Clone, Default, PartialEq, serde::Deserialize)]
-pub struct FolderConditions {
-    /// Set radius, mm.
-    pub radius_mm: Option<f64>,
-    /// Axis positions of the circle centre, mm.
-    pub position_mm: Option<Vec<f64>>,
-}
-
-/// Name of the per-folder conditions file.
-pub const CONDITIONS_FILE: &str = "rtest.toml";
-
-impl FolderConditions {
-    /// Reads `rtest.toml` in the folder of `file`; absent file → no conditions.
-    pub fn of_file(file: &Path) -> Result<Self, ReportError> {
-        let dir = match file.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
-        let path = dir.join(CONDITIONS_FILE);
-        if !path.is_file() {
-            return Ok(FolderConditions::default());
-        }
-        let name = path.display().to_string();
-        let text = std::fs::read_to_string(&path).map_err(|e| ReportError::Read {
-            path: name.clone(),
-            message: e.to_string(),
-        })?;
-        let c: FolderConditions = toml::from_str(&text).map_err(|e| ReportError::BadInput {
-            source_name: name.clone(),
-            message: e.message().trim().replace('\n', " "),
-        })?;
-        if c.radius_mm.is_some_and(|r| !(r.is_finite() && r > 0.0)) {
-            return Err(ReportError::BadInput {
-                source_name: name,
-                message: "radius_mm must be a positive number of mm".into(),
-            });
-        }
-        if c.position_mm
-            .as_ref()
-            .is_some_and(|p| p.iter().any(|v| !v.is_finite()))
-        {
-            return Err(ReportError::BadInput {
-                source_name: name,
-                message: "position_mm must be finite".into(),
-            });
-        }
-        Ok(c)
-    }
-}
-
 impl Conditions {
     /// Conditions of a measured file: its path and the position from its folder's
     /// `rtest.toml`, if any.
@@ -151,7 +100,7 @@ impl Conditions {
         Ok(Conditions {
             source: file.display().to_string(),
             machine: None,
-            position_mm: FolderConditions::of_file(file)?.position_mm,
+            position_mm: TestConditions::of_file(file)?.position_mm,
         })
     }
 

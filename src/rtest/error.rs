@@ -128,6 +128,16 @@ pub enum RtestError {
         /// The cell text.
         value: String,
     },
+    /// An invalid `rtest.toml` (test conditions of a folder).
+    #[error("{file}: {key}: {message}")]
+    Conditions {
+        /// The conditions file.
+        file: String,
+        /// The key.
+        key: String,
+        /// What is wrong.
+        message: String,
+    },
     /// A cell with a value outside its domain (EIJ tables: plane, direction, parameter, ...).
     #[error("{at}: column {column}: {message}")]
     BadValue {

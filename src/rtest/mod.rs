@@ -33,6 +33,7 @@ use serde_json::{json, Map, Value};
 
 use crate::axes::{Axis, Direction, Eij, Plane};
 
+pub mod conditions;
 pub mod error;
 pub mod fit;
 pub mod normalise;

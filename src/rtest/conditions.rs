@@ -1,0 +1,57 @@
+//! Test conditions of R-Test files that the series themselves do not carry: the set radius and
+//! the circle-centre position, stated once per folder in `rtest.toml`.
+
+use super::RtestError;
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+/// The file of a folder that states the conditions of the R-Test files in it.
+pub const CONDITIONS_FILE: &str = "rtest.toml";
+
+/// Conditions of the circle tests of one folder (`rtest.toml`); absent keys are unknown.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TestConditions {
+    /// Set radius of the circles, mm (0 < r ≤ 3, the R-Test range).
+    pub radius_mm: Option<f64>,
+    /// Axis positions of the circle centre, mm, in the machine's axis order.
+    pub position_mm: Option<Vec<f64>>,
+}
+
+impl TestConditions {
+    /// The conditions of `file`: the `rtest.toml` in its folder, or none.
+    pub fn of_file(file: &Path) -> Result<TestConditions, RtestError> {
+        let dir = match file.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        let path = dir.join(CONDITIONS_FILE);
+        if !path.is_file() {
+            return Ok(TestConditions::default());
+        }
+        let name = path.display().to_string();
+        let bad = |key: &str, message: String| RtestError::Conditions {
+            file: name.clone(),
+            key: key.to_string(),
+            message,
+        };
+        let text = std::fs::read_to_string(&path).map_err(|e| RtestError::Io {
+            path: name.clone(),
+            message: e.to_string(),
+        })?;
+        let c: TestConditions = toml::from_str(&text)
+            .map_err(|e| bad("TOML", e.message().trim().replace('\n', " ")))?;
+        if let Some(r) = c.radius_mm {
+            if !(r.is_finite() && r > 0.0 && r <= 3.0) {
+                return Err(bad("radius_mm", format!("{r} must lie in (0, 3] mm")));
+            }
+        }
+        if c.position_mm
+            .as_ref()
+            .is_some_and(|p| p.iter().any(|v| !v.is_finite()))
+        {
+            return Err(bad("position_mm", "values must be finite".into()));
+        }
+        Ok(c)
+    }
+}
