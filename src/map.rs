@@ -1,13 +1,10 @@
 //! EIJ maps over the workspace: the position-dependent model evaluated on a grid of axis
-//! positions (harmonic steady state, the same evaluation as measured data), as a compensation
-//! table position → EIJ.
+//! positions (harmonic steady state, the same simulation and evaluation as the
+//! identification), as a compensation table position → EIJ.
 
 use crate::axes::{Axis, Direction, Eij, Plane};
-use crate::control::ClosedLoop;
+use crate::ident::{simulated_eij, Settings, TestCase};
 use crate::machine::Machine;
-use crate::rtest::{self, EvalOptions};
-use crate::sim::{harmonic, output};
-use rayon::prelude::*;
 use std::collections::BTreeMap;
 
 /// Errors of a map.
@@ -144,42 +141,35 @@ pub fn eij_map(
             })
             .collect();
     }
-    positions
-        .into_par_iter()
-        .map(|position_m| {
-            let err = |m: String| MapError::Point {
-                position: position_m
-                    .iter()
+    // The same simulation and evaluation as the identification, one test per grid point.
+    let tests: Vec<TestCase> = positions
+        .iter()
+        .map(|p| TestCase {
+            source: format!(
+                "map at {} mm",
+                p.iter()
                     .map(|v| format!("{:.1}", v * 1e3))
                     .collect::<Vec<_>>()
                     .join(", ")
-                    + " mm",
-                message: m,
-            };
-            let cl = ClosedLoop::new(machine, &position_m).map_err(|e| err(e.to_string()))?;
-            let ph = harmonic::circle_phasors(
-                &cl,
-                spec.plane,
-                spec.radius_m,
-                spec.accel_m_s2,
-                spec.direction,
-            )
-            .ok_or_else(|| err("closed-loop pole at the circle frequency".into()))?;
-            let run = harmonic::steady_circle(&ph, 128, 3);
-            let series =
-                output::to_series(&cl, &run, "map".into()).map_err(|e| err(e.to_string()))?;
-            let opts = EvalOptions {
-                plane: Some(spec.plane),
-                radius_mm: Some(spec.radius_m * 1e3),
-            };
-            let (_, joint) =
-                rtest::evaluate_joint(&series, &opts).map_err(|e| err(e.to_string()))?;
-            Ok(MapPoint {
-                position_m,
-                eij: joint.eij,
-            })
+            ),
+            plane: spec.plane,
+            direction: spec.direction,
+            radius_mm: spec.radius_m * 1e3,
+            accel_m_s2: spec.accel_m_s2,
+            position_m: Some(p.clone()),
+            measured: BTreeMap::new(),
         })
-        .collect()
+        .collect();
+    let sims =
+        simulated_eij(machine, &tests, &Settings::default()).map_err(|e| MapError::Point {
+            position: "grid".into(),
+            message: e.to_string(),
+        })?;
+    Ok(positions
+        .into_iter()
+        .zip(sims)
+        .map(|(position_m, eij)| MapPoint { position_m, eij })
+        .collect())
 }
 
 /// The compensation table as CSV: `x_mm,y_mm,z_mm,plane,direction,radius_mm,accel_m_s2`, then
@@ -212,4 +202,79 @@ pub fn to_csv(machine: &Machine, spec: &MapSpec, points: &[MapPoint]) -> String 
         out.push('\n');
     }
     out
+}
+
+/// Reads a compensation table written by [`to_csv`]: the map's conditions and its points, with
+/// positions in x, y, z order.
+pub fn read_csv(path: &std::path::Path) -> Result<(MapSpec, Vec<MapPoint>), MapError> {
+    let name = path.display().to_string();
+    let bad = |line: usize, m: String| MapError::Point {
+        position: format!("{name}:{line}"),
+        message: m,
+    };
+    let text = std::fs::read_to_string(path).map_err(|e| bad(0, format!("cannot read: {e}")))?;
+    let mut reader = csv::ReaderBuilder::new().from_reader(text.as_bytes());
+    let header: Vec<String> = reader
+        .headers()
+        .map_err(|e| bad(1, e.to_string()))?
+        .iter()
+        .map(str::to_string)
+        .collect();
+    let fixed = [
+        "x_mm",
+        "y_mm",
+        "z_mm",
+        "plane",
+        "direction",
+        "radius_mm",
+        "accel_m_s2",
+    ];
+    if header.len() != fixed.len() + 6 || header[..fixed.len()] != fixed {
+        return Err(bad(
+            1,
+            format!(
+                "not an eij map table (expected {},<six EIJ>_um_s2_per_m)",
+                fixed.join(",")
+            ),
+        ));
+    }
+    let params: Vec<Eij> = header[fixed.len()..]
+        .iter()
+        .map(|h| h.strip_suffix("_um_s2_per_m").unwrap_or(h).parse::<Eij>())
+        .collect::<Result<_, _>>()
+        .map_err(|m| bad(1, m))?;
+    let mut spec: Option<MapSpec> = None;
+    let mut points = Vec::new();
+    for (i, rec) in reader.records().enumerate() {
+        let line = i + 2;
+        let rec = rec.map_err(|e| bad(line, e.to_string()))?;
+        let num = |k: usize| -> Result<f64, MapError> {
+            rec.get(k)
+                .and_then(|v| v.trim().parse::<f64>().ok())
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| bad(line, format!("column {}: not a finite number", header[k])))
+        };
+        let plane: Plane = rec.get(3).unwrap_or("").parse().map_err(|m| bad(line, m))?;
+        let direction: Direction = rec.get(4).unwrap_or("").parse().map_err(|m| bad(line, m))?;
+        let this = MapSpec {
+            plane,
+            direction,
+            radius_m: num(5)? * 1e-3,
+            accel_m_s2: num(6)?,
+        };
+        if spec.as_ref().is_some_and(|s| *s != this) {
+            return Err(bad(line, "conditions differ from the first row".into()));
+        }
+        spec = Some(this);
+        let mut eij = BTreeMap::new();
+        for (k, p) in params.iter().enumerate() {
+            eij.insert(*p, num(fixed.len() + k)?);
+        }
+        points.push(MapPoint {
+            position_m: vec![num(0)? * 1e-3, num(1)? * 1e-3, num(2)? * 1e-3],
+            eij,
+        });
+    }
+    let spec = spec.ok_or_else(|| bad(2, "no rows".into()))?;
+    Ok((spec, points))
 }

@@ -71,6 +71,10 @@ pub struct IdentifyArgs {
         allow_hyphen_values = true
     )]
     position_mm: Option<Vec<f64>>,
+    /// Also draw the identification figure (measured vs simulated EIJ before and after per
+    /// test, cost over iterations) as SVG.
+    #[arg(long, value_name = "FILE.svg")]
+    plot: Option<PathBuf>,
     /// No progress bar and no tables, only errors.
     #[arg(long)]
     quiet: bool,
@@ -279,11 +283,12 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
     let (result, seconds) = run_identification(&prep, args.quiet)?;
     let toml_text = report::machine_toml(&prep.problem, &result, &prep.provenance)
         .map_err(|e| anyhow::anyhow!("cannot write the identified machine: {e}"))?;
-    let mut json = serde_json::to_vec_pretty(&report::report_json(
-        &prep.problem,
-        &result,
-        &prep.provenance,
-    ))?;
+    let report_value = report::report_json(&prep.problem, &result, &prep.provenance);
+    let svg = match &args.plot {
+        Some(_) => Some(eij::report::identification_svg(&report_value)?),
+        None => None,
+    };
+    let mut json = serde_json::to_vec_pretty(&report_value)?;
     json.push(b'\n');
     let mut inputs: Vec<PathBuf> = measured::expand(&args.measured)?;
     inputs.push(args.machine.clone());
@@ -291,7 +296,10 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
         inputs.push(c.clone());
     }
     let input_refs: Vec<&Path> = inputs.iter().map(|p| p.as_path()).collect();
-    for out in [&args.out, &args.report] {
+    for out in [Some(&args.out), Some(&args.report), args.plot.as_ref()]
+        .into_iter()
+        .flatten()
+    {
         if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir)
                 .with_context(|| format!("{}: cannot create the folder", dir.display()))?;
@@ -299,6 +307,9 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
     }
     write_output(&args.report, &json, &input_refs)?;
     write_output(&args.out, toml_text.as_bytes(), &input_refs)?;
+    if let (Some(path), Some(svg)) = (&args.plot, &svg) {
+        write_output(path, svg.as_bytes(), &input_refs)?;
+    }
     if !args.quiet {
         print_result(&prep, &result, seconds);
         println!(

@@ -37,6 +37,9 @@ pub struct MapArgs {
     /// Output CSV (compensation table).
     #[arg(long, value_name = "FILE.csv")]
     out: PathBuf,
+    /// Also draw the map as SVG.
+    #[arg(long, value_name = "FILE.svg")]
+    plot: Option<PathBuf>,
 }
 
 /// Runs `eij map`.
@@ -66,9 +69,18 @@ pub fn run(args: MapArgs) -> anyhow::Result<()> {
         accel_m_s2: args.accel_m_s2,
     };
     let points = eij_map(&machine, &grids, &spec)?;
+    let axes: Vec<_> = machine.axes.iter().map(|a| a.axis).collect();
+    let svg = match &args.plot {
+        Some(_) => Some(eij::report::map_svg(&machine.name, &axes, &spec, &points)?),
+        None => None,
+    };
     write_output(
         &args.out,
         to_csv(&machine, &spec, &points).as_bytes(),
         &[&args.machine],
-    )
+    )?;
+    if let (Some(path), Some(svg)) = (&args.plot, svg) {
+        write_output(path, svg.as_bytes(), &[&args.machine, &args.out])?;
+    }
+    Ok(())
 }

@@ -18,6 +18,9 @@ pub struct ReportArgs {
     /// Simulated move CSVs (`eij simulate move`), one figure each.
     #[arg(long = "move", value_name = "FILE.csv", num_args = 1..)]
     moves: Vec<PathBuf>,
+    /// EIJ maps (`eij map` compensation tables), one figure each.
+    #[arg(long = "map", value_name = "FILE.csv", num_args = 1..)]
+    maps: Vec<PathBuf>,
     /// Report folder: report.html and the SVG figures (created if missing; only the report's
     /// own files in it are replaced).
     #[arg(long, value_name = "DIR")]
@@ -30,7 +33,7 @@ pub fn run(args: ReportArgs) -> anyhow::Result<()> {
         measured: args.measured,
         identify_report: args.identify_report,
         moves: args.moves,
-        extra_figures: Vec::new(),
+        extra_figures: map_figures(&args.maps)?,
         out_dir: args.out.clone(),
     })?;
     eprintln!(
@@ -39,4 +42,27 @@ pub fn run(args: ReportArgs) -> anyhow::Result<()> {
         args.out.join(report::html::REPORT_FILE).display()
     );
     Ok(())
+}
+
+/// One figure per EIJ map table.
+fn map_figures(maps: &[PathBuf]) -> anyhow::Result<Vec<report::html::Figure>> {
+    let axes = eij::axes::Axis::ALL;
+    maps.iter()
+        .enumerate()
+        .map(|(i, path)| {
+            let (spec, points) = eij::map::read_csv(path)?;
+            let svg = report::map_svg(&path.display().to_string(), &axes, &spec, &points)?;
+            Ok(report::html::Figure {
+                file_name: format!("map-{:02}.svg", i + 1),
+                caption: format!(
+                    "EIJ map {} ({} {}, {} m/s²)",
+                    path.display(),
+                    spec.plane,
+                    spec.direction,
+                    spec.accel_m_s2
+                ),
+                svg,
+            })
+        })
+        .collect()
 }

@@ -725,7 +725,7 @@ pub struct IdentResult {
     pub cost_initial: f64,
     /// Σr² at the solution.
     pub cost_final: f64,
-    /// Σr² after every iteration.
+    /// Σr² at the start and after every iteration.
     pub cost_history: Vec<f64>,
     /// Residual standard deviation s = √(Σr²/(m − n)).
     pub residual_std: f64,
@@ -789,7 +789,8 @@ pub fn identify(
     };
     let start = DVector::from_iterator(free.len(), free.iter().map(|&i| theta0[i]));
     let (lo, hi) = s.theta_bounds();
-    let costs = Arc::new(Mutex::new(Vec::new()));
+    // Cost history: the start, then after every iteration.
+    let costs = Arc::new(Mutex::new(vec![r0.norm_squared()]));
     let (theta_free, iterations, converged) = match s.method {
         Method::Lm => {
             let solver = lm::LevenbergMarquardt::new(

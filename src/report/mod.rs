@@ -6,6 +6,7 @@
 //!                            └► out_of_plane_svg  (paper Fig. 4, 7: d_k over φ, fitted plane)
 //! move CSV / sim::Run ─► MoveData ─► move_svg      (paper Fig. 9: position, acceleration, cross-talk)
 //! identify report JSON ─► identification_svg        (measured vs simulated EIJ, cost history)
+//! map::eij_map points ─► map_svg                   (EIJ over the workspace)
 //! all of it ─► html::generate ─► DIR/report.html + DIR/*.svg
 //! ```
 //!
@@ -14,7 +15,7 @@
 //! Series colours are the public constants of [`svg`], so that tests and scripts can find a
 //! series in the SVG by its stroke or fill colour.
 //!
-//! EIJ maps over the workspace are not drawn here yet: they enter a report as further
+//! EIJ maps over the workspace ([`map_svg`], from `eij map`) enter a report as further
 //! [`html::Figure`]s through [`html::ReportRequest::extra_figures`].
 
 use crate::rtest::conditions::TestConditions;
@@ -23,12 +24,14 @@ use std::path::Path;
 pub mod circle;
 pub mod html;
 pub mod ident_plot;
+pub mod map_plot;
 pub mod move_plot;
 pub mod svg;
 
 pub use circle::CircleView;
 pub use html::{generate, ReportRequest};
 pub use ident_plot::identification_svg;
+pub use map_plot::map_svg;
 pub use move_plot::{move_svg, MoveData};
 
 /// Errors of the figures and the report; every message is one line naming the file or key.

@@ -1,0 +1,138 @@
+//! EIJ maps over the workspace: each EIJ of the plane over the first gridded axis, one line per
+//! value of the second gridded axis (compensation table of `eij map`).
+
+use super::svg::{self, Entry, Mark};
+use super::{short, ReportError};
+use crate::axes::Axis;
+use crate::map::{MapPoint, MapSpec};
+use plotters::prelude::*;
+
+const PALETTE: [RGBColor; 10] = [
+    svg::INTERNAL,
+    svg::EXTERNAL,
+    svg::FIT,
+    svg::SECOND,
+    svg::ELLIPSE_EXT,
+    svg::SET,
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(188, 189, 34),
+    svg::ELLIPSE_INT,
+];
+
+/// The map figure. `axes` are the machine's axes in its order (to read positions); the axis
+/// varying fastest along the first gridded axis is drawn on the abscissa.
+pub fn map_svg(
+    machine: &str,
+    axes: &[Axis],
+    spec: &MapSpec,
+    points: &[MapPoint],
+) -> Result<String, ReportError> {
+    if points.is_empty() {
+        return Err(ReportError::BadInput {
+            source_name: "map".into(),
+            message: "no grid points".into(),
+        });
+    }
+    // Which axes vary, in the order of the grid (first = slowest).
+    let varying: Vec<usize> = (0..axes.len())
+        .filter(|&i| {
+            points
+                .iter()
+                .any(|p| (p.position_m[i] - points[0].position_m[i]).abs() > 1e-12)
+        })
+        .collect();
+    let x_axis = varying.last().copied().unwrap_or(0);
+    let group_axis = varying.iter().rev().nth(1).copied();
+    let mut groups: Vec<(f64, Vec<&MapPoint>)> = Vec::new();
+    for p in points {
+        let key = group_axis.map_or(0.0, |g| p.position_m[g]);
+        match groups.iter_mut().find(|(k, _)| (*k - key).abs() < 1e-12) {
+            Some((_, v)) => v.push(p),
+            None => groups.push((key, vec![p])),
+        }
+    }
+    let params = spec.plane.parameters();
+    let title = format!(
+        "EIJ map over {} ({}): {} circles, r = {} mm, {} m/s², {}",
+        axes[x_axis].letter(),
+        machine,
+        spec.plane,
+        short(spec.radius_m * 1e3, 3),
+        short(spec.accel_m_s2, 3),
+        spec.direction
+    );
+    let fixed: Vec<String> = (0..axes.len())
+        .filter(|i| !varying.contains(i))
+        .map(|i| {
+            format!(
+                "{} = {} mm",
+                axes[i].letter(),
+                short(points[0].position_m[i] * 1e3, 1)
+            )
+        })
+        .collect();
+    let lines = vec![format!(
+        "harmonic steady state, same evaluation as measured data · other axes: {}",
+        if fixed.is_empty() {
+            "none".to_string()
+        } else {
+            fixed.join(", ")
+        }
+    )];
+    let xs: Vec<f64> = points.iter().map(|p| p.position_m[x_axis] * 1e3).collect();
+    let (x0, x1) = svg::padded_range(xs.iter().copied(), 0.02);
+    let header_px = 16 + 30 + 22 * lines.len() as u32 + 6;
+    let (cols, rows) = (3usize, 2usize);
+    let panel = (440u32, 320u32);
+    svg::render(
+        (
+            cols as u32 * panel.0 + 260,
+            header_px + rows as u32 * panel.1,
+        ),
+        |root| {
+            let body = svg::header(root, &title, &lines)?;
+            let (grid, side) = body.split_horizontally(cols as u32 * panel.0);
+            let cells = grid.split_evenly((rows, cols));
+            let mut legend = Vec::new();
+            for (g, (key, _)) in groups.iter().enumerate() {
+                let label = match group_axis {
+                    Some(a) => format!("{} = {} mm", axes[a].letter(), short(key * 1e3, 1)),
+                    None => "EIJ".to_string(),
+                };
+                legend.push(Entry::new(label, PALETTE[g % PALETTE.len()], Mark::Line));
+            }
+            for (cell, e) in cells.iter().zip(params.iter()) {
+                let (lo, hi) = svg::padded_range(points.iter().map(|p| p.eij[e]), 0.1);
+                let mut chart = ChartBuilder::on(cell)
+                    .margin(10)
+                    .caption(format!("{e} / (µm·s²/m)"), (svg::FONT, svg::TEXT_SIZE))
+                    .x_label_area_size(45)
+                    .y_label_area_size(70)
+                    .build_cartesian_2d(x0..x1, lo..hi)?;
+                svg::mesh(
+                    &mut chart,
+                    &format!("{} / mm", axes[x_axis].letter()),
+                    "",
+                    svg::decimals_for(x1 - x0),
+                    svg::decimals_for(hi - lo),
+                )?;
+                for (g, (_, pts)) in groups.iter().enumerate() {
+                    let color = PALETTE[g % PALETTE.len()];
+                    let series: Vec<(f64, f64)> = pts
+                        .iter()
+                        .map(|p| (p.position_m[x_axis] * 1e3, p.eij[e]))
+                        .collect();
+                    chart.draw_series(LineSeries::new(series.clone(), color.stroke_width(2)))?;
+                    chart.draw_series(
+                        series
+                            .into_iter()
+                            .map(|q| Circle::new(q, 3, color.filled())),
+                    )?;
+                }
+            }
+            svg::side_panel(&side, &legend, &[])?;
+            Ok(())
+        },
+    )
+}
