@@ -1,21 +1,53 @@
 //! Benchmarks of the modelling chain on the demo machine: assembly, modal analysis, closed loop,
-//! discretisation and a circle simulation (3 steady revolutions at 10 kHz output).
+//! discretisation, one circle test's EIJ in the time domain and harmonically, and scaling with
+//! the number of bodies (a synthetic chain) and with the number of samples.
 //!
 //! Run: `cargo bench --bench simulation`
 
-use criterion::{criterion_group, criterion_main, Criterion};
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use eij::axes::{Direction, Plane};
 use eij::control::ClosedLoop;
 use eij::machine::Machine;
 use eij::mbs::{modal, Model};
+use eij::rtest::{evaluate_joint, EvalOptions};
 use eij::sim::setpoint::Circle;
-use eij::sim::{simulate_discrete, Discrete};
+use eij::sim::{harmonic, output, simulate_discrete, Discrete};
 use std::hint::black_box;
 use std::path::Path;
 
 fn demo() -> Machine {
     Machine::from_file(&Path::new(env!("CARGO_MANIFEST_DIR")).join("machines/demo-vmc.toml"))
         .unwrap()
+}
+
+/// A synthetic machine: a chain of `n` bodies of 500 kg, each on four joints on the previous
+/// one, with an X slide on guideways and a ball screw on the last (6·n + 7 DOF).
+fn chain(n: usize) -> Machine {
+    let mut t = String::from(
+        "name = \"chain\"\n[tcp]\nbody = \"slide\"\npoint_m = [0.0, 0.0, 0.3]\n[workpiece]\nbody = \"ground\"\npoint_m = [0.0, 0.0, 0.3]\n[[body]]\nname = \"ground\"\nfixed = true\n",
+    );
+    for i in 1..=n {
+        t += &format!(
+            "[[body]]\nname = \"b{i}\"\nmass_kg = 500.0\ncog_m = [0.0, 0.0, 0.0]\ninertia_kg_m2 = [[40.0, 0.0, 0.0], [0.0, 50.0, 0.0], [0.0, 0.0, 60.0]]\n"
+        );
+        let below = if i == 1 {
+            "ground".to_string()
+        } else {
+            format!("b{}", i - 1)
+        };
+        for (k, (x, y)) in [(0.4, 0.3), (-0.4, 0.3), (0.4, -0.3), (-0.4, -0.3)]
+            .iter()
+            .enumerate()
+        {
+            t += &format!(
+                "[[joint]]\nname = \"j{i}-{k}\"\nbody = \"b{i}\"\nother = \"{below}\"\npoint_m = [{x}, {y}, -0.1]\nstiffness_n_per_m = [2e8, 2e8, 5e8]\ndamping_n_s_per_m = [2e4, 2e4, 4e4]\n"
+            );
+        }
+    }
+    t += &format!(
+        "[[body]]\nname = \"slide\"\nmass_kg = 300.0\ncog_m = [0.0, 0.0, 0.15]\ninertia_kg_m2 = [[10.0, 0.0, 0.0], [0.0, 15.0, 0.0], [0.0, 0.0, 20.0]]\n[[axis]]\nname = \"x\"\ncarrier = \"b{n}\"\nmoving = \"slide\"\nstroke_m = [-0.2, 0.2]\n[axis.guideway]\ncarriage = \"HIWIN HGH25CA ZA\"\ndamping_normal_n_s_per_m = 1.5e4\ndamping_lateral_n_s_per_m = 1.5e4\n[[axis.guideway.rail]]\nnormal = [0.0, 0.0, 1.0]\ncarriages_m = [[0.2, 0.2, 0.05], [-0.2, 0.2, 0.05]]\n[[axis.guideway.rail]]\nnormal = [0.0, 0.0, 1.0]\ncarriages_m = [[0.2, -0.2, 0.05], [-0.2, -0.2, 0.05]]\n[axis.drive]\nnut_m = [0.0, 0.0, 0.08]\nbearing_m = [-0.5, 0.0, 0.08]\nscale_m = [0.0, 0.25, 0.05]\nlead_m = 0.02\nscrew_diameter_m = 0.028\nsupport = \"fixed-free\"\nnut_stiffness_n_per_um = 900.0\nbearing_stiffness_n_per_um = 1000.0\ndamping_n_s_per_m = 5e3\nrotor_inertia_kg_m2 = 0.005\n[axis.control]\nkv_per_s = 50.0\nkp_nm_s_per_rad = 3.0\ntn_s = 0.01\ncurrent_lag_s = 0.0005\n"
+    );
+    Machine::from_toml_str(&t, "chain").unwrap()
 }
 
 fn bench(c: &mut Criterion) {
@@ -47,6 +79,66 @@ fn bench(c: &mut Criterion) {
             })
         },
     );
+    let opts = EvalOptions {
+        plane: Some(Plane::Zx),
+        radius_mm: Some(2.0),
+    };
+    c.bench_function(
+        "EIJ of one circle, time domain (simulate 10 kHz + evaluate)",
+        |b| {
+            b.iter(|| {
+                let run = simulate_discrete(&cl, &disc, &circle).unwrap();
+                let s = output::to_series(&cl, &run, "t".into()).unwrap();
+                evaluate_joint(black_box(&s), &opts).unwrap().1
+            })
+        },
+    );
+    c.bench_function("EIJ of one circle, harmonic (phasors + evaluate)", |b| {
+        b.iter(|| {
+            let ph = harmonic::circle_phasors(&cl, Plane::Zx, 0.002, 5.0, Direction::Ccw).unwrap();
+            let run = harmonic::steady_circle(&ph, 128, 4);
+            let s = output::to_series(&cl, &run, "h".into()).unwrap();
+            evaluate_joint(black_box(&s), &opts).unwrap().1
+        })
+    });
+
+    let mut group = c.benchmark_group("bodies");
+    for n in [1usize, 4, 16] {
+        let m = chain(n);
+        let pose = m.reference_pose();
+        group.bench_with_input(BenchmarkId::new("assemble", 6 * (n + 1) + 1), &m, |b, m| {
+            b.iter(|| Model::assemble(m, &pose).unwrap())
+        });
+        group.bench_with_input(
+            BenchmarkId::new("closed loop + checks", 6 * (n + 1) + 1),
+            &m,
+            |b, m| b.iter(|| ClosedLoop::new(m, &pose).unwrap()),
+        );
+        let cl = ClosedLoop::new(&m, &pose).unwrap();
+        group.bench_with_input(
+            BenchmarkId::new("frequency response H(jω)", 6 * (n + 1) + 1),
+            &cl,
+            |b, cl| b.iter(|| cl.frequency_response(black_box(50.0)).unwrap()),
+        );
+    }
+    group.finish();
+
+    let mut group = c.benchmark_group("samples");
+    for rate in [1_000.0, 10_000.0, 100_000.0] {
+        let disc = Discrete::new(&cl, 1.0 / rate);
+        let n = (circle_duration(&circle) * rate) as usize;
+        group.bench_with_input(
+            BenchmarkId::new("time-domain circle", n),
+            &disc,
+            |b, disc| b.iter(|| simulate_discrete(&cl, disc, &circle).unwrap()),
+        );
+    }
+    group.finish();
+}
+
+fn circle_duration(c: &Circle) -> f64 {
+    use eij::sim::setpoint::SetPoint;
+    c.duration_s()
 }
 
 criterion_group!(benches, bench);

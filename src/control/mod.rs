@@ -307,6 +307,14 @@ impl ClosedLoop {
     /// (Re λ = 0 up to round-off, |Re λ| ≤ 1e-9·|λ|); they are marginally stable and accepted.
     pub fn check_stability(&self, machine: &Machine) -> Result<(), ControlError> {
         let n = self.a.nrows();
+        let unstable = |re: f64, im: f64| re > 1e-9 * (re * re + im * im).sqrt();
+        // Eigenvalues alone decide; eigenvectors are computed only to name the axis.
+        let values = self.eigenvalues().ok_or_else(|| ControlError::Eigen {
+            machine: machine.source.clone(),
+        })?;
+        if !values.iter().any(|l| unstable(l.re, l.im)) {
+            return Ok(());
+        }
         let a = faer::Mat::<f64>::from_fn(n, n, |i, j| self.a[(i, j)]);
         let eig = a.eigen().map_err(|_| ControlError::Eigen {
             machine: machine.source.clone(),
@@ -316,8 +324,7 @@ impl ClosedLoop {
         let mut worst: Option<usize> = None;
         for k in 0..n {
             let re = s[k].re;
-            let tol = 1e-9 * (re * re + s[k].im * s[k].im).sqrt();
-            if re > tol && worst.is_none_or(|w| re > s[w].re) {
+            if unstable(re, s[k].im) && worst.is_none_or(|w| re > s[w].re) {
                 worst = Some(k);
             }
         }
