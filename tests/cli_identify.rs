@@ -239,3 +239,28 @@ fn time_domain_and_harmonic_identifications_agree() {
         );
     }
 }
+
+#[test]
+fn nelder_mead_fallback_agrees_with_levenberg_marquardt() {
+    let lm = Scratch::new("lm");
+    let nm = Scratch::new("nm");
+    assert!(identify(&lm, &[]).status.success());
+    let out = identify(&nm, &["--method", "nelder-mead", "--max-iters", "500"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let value = |s: &Scratch, i: usize| -> f64 {
+        let json: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(s.path("id.json")).unwrap()).unwrap();
+        json["parameters"][i]["identified"].as_f64().unwrap()
+    };
+    for i in 0..2 {
+        let (a, b) = (value(&lm, i), value(&nm, i));
+        assert!(
+            (a / b - 1.0).abs() < 0.01,
+            "parameter {i}: LM {a}, Nelder-Mead {b}"
+        );
+    }
+}

@@ -40,8 +40,9 @@ pub struct IdentifyArgs {
         default_value = "out/demo-vmc-identify-report.json"
     )]
     report: PathBuf,
-    /// Identification settings (TOML: parameters, method, max_iters, min_factor, max_factor,
-    /// rate_hz, revolutions, radius_mm, table_std_err_um_s2_per_m).
+    /// Identification settings (TOML: parameters, solver, method, max_iters, tol_cost,
+    /// tol_step, min_factor, max_factor, rate_hz, revolutions, radius_mm, position_mm,
+    /// table_std_err_um_s2_per_m).
     #[arg(long, value_name = "FILE.toml")]
     config: Option<PathBuf>,
     /// Parameters to identify, e.g. `z.guideway_normal` (repeatable; default: normal and

@@ -19,6 +19,10 @@ pub struct IdentConfig {
     pub method: Option<Method>,
     /// Iteration limit.
     pub max_iters: Option<u64>,
+    /// Relative decrease of Σr² that counts as converged.
+    pub tol_cost: Option<f64>,
+    /// Step in θ = 1/p that counts as converged.
+    pub tol_step: Option<f64>,
     /// Lower bound of every factor.
     pub min_factor: Option<f64>,
     /// Upper bound of every factor.
@@ -57,6 +61,10 @@ impl IdentConfig {
         };
         if let Some(v) = self.method {
             s.method = v;
+            // Nelder–Mead needs far more (cheaper) iterations than Levenberg–Marquardt.
+            if v == Method::NelderMead && self.max_iters.is_none() {
+                s.max_iters = 2000;
+            }
         }
         if let Some(v) = self.solver {
             s.solver = v;
@@ -69,6 +77,8 @@ impl IdentConfig {
         }
         for (k, src, dst) in [
             ("min_factor", self.min_factor, &mut s.min_factor),
+            ("tol_cost", self.tol_cost, &mut s.tol_cost),
+            ("tol_step", self.tol_step, &mut s.tol_step),
             ("max_factor", self.max_factor, &mut s.max_factor),
             ("rate_hz", self.rate_hz, &mut s.rate_hz),
             ("radius_mm", self.radius_mm, &mut m.radius_mm),

@@ -248,7 +248,7 @@ pub struct Settings {
     pub min_factor: f64,
     /// Upper bound of every factor (10).
     pub max_factor: f64,
-    /// Iteration limit (50).
+    /// Iteration limit (50; 2000 for Nelder–Mead through [`config::IdentConfig`]).
     pub max_iters: u64,
     /// Relative cost decrease that counts as converged (1e-10).
     pub tol_cost: f64,
@@ -663,12 +663,16 @@ impl CostFunction for Reduced<'_> {
     type Param = DVector<f64>;
     type Output = f64;
     fn cost(&self, theta: &DVector<f64>) -> Result<f64, argmin::core::Error> {
+        // Outside the bounds the model is evaluated on the bound and the excess is penalised,
+        // so that the simplex is pushed back instead of drifting over a flat cost.
         let (lo, hi) = self.problem.settings.theta_bounds();
         let clamped = theta.map(|t| t.clamp(lo, hi));
-        Ok(self
+        let excess = (theta - &clamped).norm_squared() / (hi - lo).powi(2);
+        let cost = self
             .problem
             .residuals_at(&self.full(&clamped))?
-            .norm_squared())
+            .norm_squared();
+        Ok(cost * (1.0 + 1e3 * excess) + 1e3 * excess)
     }
 }
 
@@ -829,7 +833,9 @@ pub fn identify(
                 simplex.push(v);
             }
             let solver = argmin::solver::neldermead::NelderMead::new(simplex)
-                .with_sd_tolerance(1e-10)
+                // Converged when the simplex costs spread by less than 1e-7 of the
+                // starting cost (NM has no gradient to test).
+                .with_sd_tolerance((1e-7 * r0.norm_squared()).max(1e-12))
                 .map_err(|e| IdentError::Optimiser(e.to_string()))?;
             let observer = Progress {
                 costs: costs.clone(),
