@@ -197,7 +197,11 @@ fn report_folder_is_offline_complete_and_holds_the_numbers() {
     };
     for f in ["zx_ccw_3.csv", "xy_cw_5.csv"] {
         let res = evaluate(&CircleSeries::read_csv(measured.join(f)).unwrap(), &opts).unwrap();
-        let row_start = html.find(&format!("<td class=\"l\">{f}</td>")).expect(f);
+        // The file column shows folder/name (names repeat across test positions).
+        let folder = measured.file_name().unwrap().to_string_lossy();
+        let row_start = html
+            .find(&format!("<td class=\"l\">{folder}/{f}</td>"))
+            .expect(f);
         let row = &html[row_start..row_start + html[row_start..].find("</tr>").unwrap()];
         for p in res.plane.parameters() {
             for v in [res.eij[&p], res.std_err[&p]] {

@@ -42,45 +42,9 @@ fn is_table(path: &Path) -> bool {
         .unwrap_or(false)
 }
 
-/// The `*.csv` files of a folder and, recursively, of its sub-folders, sorted by path.
-fn folder_files(dir: &Path) -> Result<Vec<PathBuf>, IdentError> {
-    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
-        .map_err(|e| IdentError::Test {
-            input: dir.display().to_string(),
-            message: format!("cannot read folder: {e}"),
-        })?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .collect();
-    entries.sort();
-    let mut files = Vec::new();
-    for e in entries {
-        if e.is_dir() {
-            files.extend(folder_files(&e)?);
-        } else if e.extension().is_some_and(|x| x.eq_ignore_ascii_case("csv")) {
-            files.push(e);
-        }
-    }
-    Ok(files)
-}
-
 /// Expands folders (their `*.csv`, sub-folders included, sorted) and keeps files.
 pub fn expand(paths: &[PathBuf]) -> Result<Vec<PathBuf>, IdentError> {
-    let mut files = Vec::new();
-    for p in paths {
-        if p.is_dir() {
-            let inside = folder_files(p)?;
-            if inside.is_empty() {
-                return Err(IdentError::Test {
-                    input: p.display().to_string(),
-                    message: "folder holds no .csv files".into(),
-                });
-            }
-            files.extend(inside);
-        } else {
-            files.push(p.clone());
-        }
-    }
-    Ok(files)
+    Ok(crate::rtest::conditions::expand_inputs(paths)?)
 }
 
 /// Reads every path into test cases (R-Test series are evaluated; tables grouped by plane,

@@ -58,41 +58,22 @@ struct CircleEntry {
     conditions: Conditions,
 }
 
-/// Expands files and folders: folders give their `*.csv` files, sorted; non-CSV files in a
-/// folder are skipped. A missing path or a folder without CSV files is an error.
+/// Expands files and folders (see [`crate::rtest::conditions::expand_inputs`]).
 pub fn expand_measured(paths: &[PathBuf]) -> Result<Vec<PathBuf>, ReportError> {
-    let mut files = Vec::new();
-    for p in paths {
-        let name = p.display().to_string();
-        if p.is_dir() {
-            let mut inside: Vec<PathBuf> = std::fs::read_dir(p)
-                .map_err(|e| ReportError::Read {
-                    path: name.clone(),
-                    message: format!("cannot read folder: {e}"),
-                })?
-                .filter_map(|e| e.ok().map(|e| e.path()))
-                .filter(|f| {
-                    f.is_file() && f.extension().is_some_and(|x| x.eq_ignore_ascii_case("csv"))
-                })
-                .collect();
-            inside.sort();
-            if inside.is_empty() {
-                return Err(ReportError::Read {
-                    path: name,
-                    message: "folder holds no .csv files".into(),
-                });
-            }
-            files.extend(inside);
-        } else if p.is_file() {
-            files.push(p.clone());
-        } else {
-            return Err(ReportError::Read {
-                path: name,
-                message: "file not found".into(),
-            });
-        }
+    Ok(crate::rtest::conditions::expand_inputs(paths)?)
+}
+
+/// `folder/name` of a path: the name alone is ambiguous when several folders (test positions)
+/// hold files of the same name.
+fn folder_and_name(path: &Path) -> String {
+    let name = path
+        .file_name()
+        .map(|f| f.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    match path.parent().and_then(|p| p.file_name()) {
+        Some(dir) => format!("{}/{name}", dir.to_string_lossy()),
+        None => name,
     }
-    Ok(files)
 }
 
 /// A file-name-safe stem of `path`.
@@ -428,11 +409,7 @@ fn circle_tables(h: &mut String, circles: &[CircleEntry]) {
         let _ = writeln!(h, "<th>rms / µm</th></tr>");
         for (i, c) in entries {
             let r = &c.result;
-            let file = c
-                .path
-                .file_name()
-                .map(|f| f.to_string_lossy().into_owned())
-                .unwrap_or_default();
+            let file = folder_and_name(&c.path);
             let _ = write!(
                 h,
                 "<tr><td>{i}</td><td class=\"l\">{}</td><td>{}</td><td>{}</td><td>{:.3}</td><td>{:.3}</td><td>{}</td>",
@@ -509,11 +486,7 @@ fn identification_html(h: &mut String, rep: &IdentReport, fig: &Figure) {
         let source = t
             .source
             .as_deref()
-            .map(|s| {
-                Path::new(s)
-                    .file_name()
-                    .map_or(s.to_string(), |f| f.to_string_lossy().into_owned())
-            })
+            .map(|s| folder_and_name(Path::new(s)))
             .unwrap_or_default();
         for (p, m) in &t.measured {
             let fin = t.simulated_final.get(p).copied().unwrap_or(f64::NAN);

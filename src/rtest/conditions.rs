@@ -55,3 +55,51 @@ impl TestConditions {
         Ok(c)
     }
 }
+
+/// The `*.csv` files of a folder and, recursively, of its sub-folders, sorted by path.
+fn folder_files(dir: &Path) -> Result<Vec<PathBuf>, RtestError> {
+    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(|e| RtestError::Io {
+            path: dir.display().to_string(),
+            message: format!("cannot read folder: {e}"),
+        })?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .collect();
+    entries.sort();
+    let mut files = Vec::new();
+    for e in entries {
+        if e.is_dir() {
+            files.extend(folder_files(&e)?);
+        } else if e.extension().is_some_and(|x| x.eq_ignore_ascii_case("csv")) {
+            files.push(e);
+        }
+    }
+    Ok(files)
+}
+
+/// Expands the measured inputs of a command: files stay, folders give their `*.csv` files and
+/// those of their sub-folders, sorted by path (other files are skipped). A missing path or a
+/// folder without CSV files is an error.
+pub fn expand_inputs(paths: &[PathBuf]) -> Result<Vec<PathBuf>, RtestError> {
+    let mut files = Vec::new();
+    for p in paths {
+        if p.is_dir() {
+            let inside = folder_files(p)?;
+            if inside.is_empty() {
+                return Err(RtestError::Io {
+                    path: p.display().to_string(),
+                    message: "folder holds no .csv files".into(),
+                });
+            }
+            files.extend(inside);
+        } else if p.is_file() {
+            files.push(p.clone());
+        } else {
+            return Err(RtestError::Io {
+                path: p.display().to_string(),
+                message: "file not found".into(),
+            });
+        }
+    }
+    Ok(files)
+}
