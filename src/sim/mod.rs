@@ -168,3 +168,71 @@ pub fn simulate_discrete(
     }
     Ok(run)
 }
+
+/// A closed loop assembled at one stretch of a long move, with its discretisation; it is used
+/// from `from_s` on (until the next segment starts).
+#[derive(Debug, Clone)]
+pub struct Segment {
+    /// Start time, s.
+    pub from_s: f64,
+    /// The closed loop assembled at the middle of the stretch.
+    pub closed_loop: ClosedLoop,
+    /// Its discretisation at the run's step.
+    pub discrete: Discrete,
+}
+
+/// Simulates a set point over several segments, each with the model assembled where the axis
+/// then is (position dependence along long moves). The state carries over unchanged at a
+/// switch: displacements along the drive are rigid-body motions that neither model strains
+/// (K·v = D·v = 0 for the drive mode v), so both models read the same state alike and only the
+/// stiffness met by the deformation changes. Segments must share one machine and step size.
+pub fn simulate_segments(segments: &[Segment], setpoint: &dyn SetPoint) -> Result<Run, SimError> {
+    let first = segments
+        .first()
+        .ok_or_else(|| SimError::Invalid("no segment to simulate".into()))?;
+    let h = first.discrete.step_s;
+    if segments.iter().any(|s| s.discrete.step_s != h) {
+        return Err(SimError::Invalid(
+            "segments with different step sizes".into(),
+        ));
+    }
+    let cl0 = &first.closed_loop;
+    let steps = (setpoint.duration_s() / h).ceil() as usize;
+    let (nu, nx, ny) = (cl0.b.ncols(), cl0.a.nrows(), cl0.c.nrows());
+    let mut u_now = DVector::zeros(nu);
+    let mut u_next = DVector::zeros(nu);
+    setpoint.eval(0.0, &cl0.axes, u_now.as_mut_slice());
+    let mut x = cl0.equilibrium(&u_now).ok_or(SimError::NoEquilibrium)?;
+    let mut x_next = DVector::zeros(nx);
+    let mut run = Run {
+        t_s: Vec::with_capacity(steps + 1),
+        nu,
+        ny,
+        inputs: Vec::with_capacity((steps + 1) * nu),
+        outputs: Vec::with_capacity((steps + 1) * ny),
+    };
+    let mut y = DVector::zeros(ny);
+    let mut active = 0;
+    for k in 0..=steps {
+        let t = k as f64 * h;
+        while active + 1 < segments.len() && segments[active + 1].from_s <= t {
+            active += 1;
+        }
+        let seg = &segments[active];
+        y.gemv(1.0, &seg.closed_loop.c, &x, 0.0);
+        y.gemv(1.0, &seg.closed_loop.d, &u_now, 1.0);
+        run.t_s.push(t);
+        run.inputs.extend_from_slice(u_now.as_slice());
+        run.outputs.extend_from_slice(y.as_slice());
+        if k == steps {
+            break;
+        }
+        setpoint.eval(t + h, &cl0.axes, u_next.as_mut_slice());
+        x_next.gemv(1.0, &seg.discrete.phi, &x, 0.0);
+        x_next.gemv(1.0, &seg.discrete.gamma0, &u_now, 1.0);
+        x_next.gemv(1.0, &seg.discrete.gamma1, &u_next, 1.0);
+        std::mem::swap(&mut x, &mut x_next);
+        std::mem::swap(&mut u_now, &mut u_next);
+    }
+    Ok(run)
+}

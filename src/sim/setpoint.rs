@@ -247,6 +247,23 @@ impl JerkLimitedMove {
         (self.distance_m, 0.0, 0.0)
     }
 
+    /// The time at which the set position has covered `fraction` (0…1) of the distance
+    /// (the profile is monotonic; bisection to 1e-12 s).
+    pub fn time_at_fraction(&self, fraction: f64) -> f64 {
+        let target = fraction.clamp(0.0, 1.0) * self.distance_m;
+        let (mut lo, mut hi) = (self.lead_s, self.lead_s + self.motion_s());
+        while hi - lo > 1e-12 {
+            let mid = 0.5 * (lo + hi);
+            let (p, _, _) = self.state(mid);
+            if (p - target) * self.distance_m.signum() < 0.0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        hi
+    }
+
     /// Duration of the motion itself (without the rests), s.
     pub fn motion_s(&self) -> f64 {
         self.phases().iter().map(|(dt, _)| dt).sum()
