@@ -61,13 +61,20 @@ pub fn rows_from_result(result: &CircleResult) -> Vec<EijRow> {
 /// a finite non-negative standard error (an empty cell means unknown). At least one row.
 pub fn read(path: impl AsRef<Path>) -> Result<Vec<EijRow>, RtestError> {
     let path = path.as_ref();
-    let name = path.display().to_string();
     let bytes = read_file(path)?;
+    from_bytes(&path.display().to_string(), &bytes)
+}
+
+/// As [`read`] on the bytes of a file already read; `name` stands for the file in error
+/// messages. A leading UTF-8 byte-order mark is dropped.
+pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<Vec<EijRow>, RtestError> {
+    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    let name = name.to_string();
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(false)
         .trim(csv::Trim::All)
-        .from_reader(bytes.as_slice());
-    let mut counter = LineCounter::new(&bytes);
+        .from_reader(bytes);
+    let mut counter = LineCounter::new(bytes);
     let mut records = reader.records();
     let expected = || format!("{},{}", COLUMNS.join(","), STD_ERR_COLUMN);
     let header = match records.next() {
