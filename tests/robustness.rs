@@ -149,6 +149,42 @@ fn csv_not_utf8() {
     );
 }
 
+/// Found by fuzzing (`fuzz/`): a quoted cell spanning lines was echoed into the message, which
+/// then spanned lines too. Cell text is now escaped and cut.
+#[test]
+fn csv_quoted_cell_with_line_ends_stays_on_one_line() {
+    let s = Scratch::new("quoted");
+    let f = s.write(
+        "quoted.csv",
+        format!("{HEADER}\n0,2,0,0,2,0,\"2.0\n0.001,2,0,0,2,0,2\n0.002,2,0,0,2,0,2\"\n"),
+    );
+    refused(
+        &s,
+        &["evaluate", &f],
+        &[&format!(
+            "{f}:2: column z_ext_mm: '2.0\\n0.001,2,0,0,2,0,2\\n0.002,2,0,0,2,0,2' is not a number"
+        )],
+    );
+    let t = s.write(
+        "table.csv",
+        "plane,direction,accel_m_s2,parameter,value_um_s2_per_m,\"no\nte\"\nzx,ccw,4.5,EXZ,1,a\n",
+    );
+    let line = refused(
+        &s,
+        &[
+            "identify",
+            "--machine",
+            DEMO,
+            "--measured",
+            &t,
+            "--out",
+            &s.s("o.toml"),
+        ],
+        &[&format!("{t}:1: unknown column 'no\\nte'")],
+    );
+    assert!(line.len() < 300, "{line}");
+}
+
 #[test]
 fn csv_without_circular_motion() {
     let s = Scratch::new("no-motion");
@@ -806,4 +842,87 @@ fn existing_outputs_are_replaced_atomically() {
         &["evaluate", ZX_CSV, "--csv-out", &t],
         "plane,direction,",
     );
+}
+
+// ---- Outputs of `eij identify` ------------------------------------------------------------
+// `src/cli/identify.rs` creates missing output folders, writes `--report` before it finds that
+// `--out` cannot be written, and does not count the folder's `rtest.toml` among its inputs.
+// These tests state the contract; they are ignored until identify checks its outputs first
+// (`eij::io::check_outputs`) — see docs/bad-inputs.md.
+
+fn quick_identify(s: &Scratch, out: &str, report: &str) -> Vec<String> {
+    let (m, _) =
+        measured_with_conditions(s, "radius_mm = 2.0\nposition_mm = [150.0, -100.0, 0.0]\n");
+    identify(s, &m, out, report)
+        .into_iter()
+        .map(String::from)
+        .collect()
+}
+
+#[test]
+#[ignore = "identify creates missing output folders (src/cli/identify.rs)"]
+fn identify_output_in_a_missing_folder() {
+    let s = Scratch::new("id-nowhere");
+    let x = s.s("no-such-dir/x.toml");
+    let args = quick_identify(&s, &x, &s.s("id.json"));
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    refused(
+        &s,
+        &args,
+        &[&format!(
+            "{x}: cannot write: folder {} does not exist",
+            s.s("no-such-dir")
+        )],
+    );
+}
+
+#[test]
+#[ignore = "identify writes --report before it refuses --out (src/cli/identify.rs)"]
+fn identify_output_that_is_a_folder_leaves_no_report() {
+    let s = Scratch::new("id-folder");
+    let dir = s.s("sub");
+    std::fs::create_dir_all(&dir).unwrap();
+    let args = quick_identify(&s, &dir, &s.s("id.json"));
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    refused(&s, &args, &[&format!("{dir}: is a folder, not a file")]);
+}
+
+#[test]
+#[ignore = "identify accepts the same path for --out and --report (src/cli/identify.rs)"]
+fn identify_out_and_report_the_same_file() {
+    let s = Scratch::new("id-same");
+    let args = quick_identify(&s, &s.s("id.toml"), &s.s("id.toml"));
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    refused(&s, &args, &["given for two outputs of the same run"]);
+}
+
+#[test]
+#[ignore = "identify overwrites the folder's rtest.toml, an input (src/cli/identify.rs)"]
+fn identify_report_over_the_conditions_file() {
+    let s = Scratch::new("id-conditions");
+    let c = s.s("m/rtest.toml");
+    let args = quick_identify(&s, &s.s("id.toml"), &c);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    refused(
+        &s,
+        &args,
+        &[&format!("{c}: refusing to overwrite an input file")],
+    );
+}
+
+#[test]
+fn identify_output_over_an_input_is_refused() {
+    let s = Scratch::new("id-clobber");
+    let (m, _) = measured_with_conditions(&s, "radius_mm = 2.0\n");
+    let csv = format!("{m}/zx_ccw_5.csv");
+    let before = std::fs::read(&csv).unwrap();
+    let out = eij(&identify(&s, &m, &csv, &s.s("id.json")));
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(
+        stderr.contains(&format!("{csv}: refusing to overwrite an input file")),
+        "{stderr}"
+    );
+    assert_eq!(std::fs::read(&csv).unwrap(), before);
 }

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use super::error::{Line, Location, RtestError};
+use super::error::{quote_cell, Line, Location, RtestError};
 use crate::axes::Axis;
 
 /// Column names of the internal readings, x, y, z.
@@ -121,7 +121,7 @@ impl CircleSeries {
                 if index[k] != usize::MAX {
                     return Err(RtestError::DuplicateColumn {
                         at: header_at,
-                        column: cell.to_string(),
+                        column: quote_cell(cell),
                     });
                 }
                 index[k] = i;
@@ -348,12 +348,12 @@ pub(crate) fn parse_number(
         Err(_) => Err(RtestError::NotANumber {
             at: at(),
             column: column.to_string(),
-            value: text.to_string(),
+            value: quote_cell(text),
         }),
         Ok(v) if !v.is_finite() => Err(RtestError::NotFinite {
             at: at(),
             column: column.to_string(),
-            value: text.to_string(),
+            value: quote_cell(text),
         }),
         Ok(v) => Ok(v),
     }
