@@ -582,6 +582,11 @@ fn sample_rate_too_low_or_too_high() {
         &circle(&out, &["--noise-um", "-1"]),
         &["--noise-um: -1 must be ≥ 0"],
     );
+    refused(
+        &s,
+        &circle(&out, &["--decimals", "20"]),
+        &["--decimals: 20 is more than the 15 an f64 holds"],
+    );
 }
 
 #[test]
@@ -652,6 +657,10 @@ fn rtest_toml_bad_key_or_value() {
             "rtest.toml: line 1, column 13: invalid type: string \"two\", expected f64",
         ),
         ("radius_mm = 7.0\n", "rtest.toml: radius_mm: 7 must lie in (0, 3] mm"),
+        (
+            "position_mm = []\n",
+            "rtest.toml: position_mm: empty; give one position per machine axis",
+        ),
         (
             "position_mm = [0.0, nan, 0.0]\n",
             "rtest.toml: position_mm: values must be finite",

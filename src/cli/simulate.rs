@@ -111,6 +111,13 @@ const MAX_SAMPLES: f64 = 1e6;
 /// for the evaluation to see the circle.
 fn check_samples(common: &Common, sp: &dyn SetPoint, freq_hz: Option<f64>) -> anyhow::Result<()> {
     let rate = positive("rate-hz", common.rate_hz)?;
+    // Beyond 15 decimals an f64 has no more digits to give.
+    if common.decimals > 15 {
+        bail!(
+            "--decimals: {} is more than the 15 an f64 holds",
+            common.decimals
+        );
+    }
     let samples = sp.duration_s() * rate;
     if samples.is_nan() || samples > MAX_SAMPLES {
         bail!(
@@ -256,7 +263,7 @@ fn write_run(
     let run = simulate(cl, sp, rate)?;
     let opts = output::CsvOptions {
         required_only: common.required_only,
-        decimals: common.decimals.min(15),
+        decimals: common.decimals,
         noise_um: common.noise_um,
         seed: common.seed,
     };

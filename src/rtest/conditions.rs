@@ -60,6 +60,12 @@ impl TestConditions {
         {
             return Err(bad("position_mm", "values must be finite".into()));
         }
+        if c.position_mm.as_ref().is_some_and(Vec::is_empty) {
+            return Err(bad(
+                "position_mm",
+                "empty; give one position per machine axis".into(),
+            ));
+        }
         Ok(c)
     }
 }
