@@ -155,6 +155,14 @@ mod tests {
             .filter(|e| e.file_name().to_string_lossy().ends_with(".tmp"))
             .collect();
         assert!(leftovers.is_empty());
+        let other = dir.join("other.txt");
+        let err = check_outputs(&[&other, &dir.join(".").join("other.txt")], &[]).unwrap_err();
+        assert!(matches!(err, WriteError::SameOutput { .. }), "{err}");
+        let err = write_atomic(&dir, b"x", &[]).unwrap_err();
+        assert!(matches!(err, WriteError::IsAFolder { .. }), "{err}");
+        let err = write_atomic(&dir.join("no/such.txt"), b"x", &[]).unwrap_err();
+        assert!(matches!(err, WriteError::NoFolder { .. }), "{err}");
+        assert!(!other.exists() && !dir.join("no").exists());
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

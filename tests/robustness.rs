@@ -851,6 +851,48 @@ fn existing_outputs_are_replaced_atomically() {
         &["evaluate", ZX_CSV, "--csv-out", &t],
         "plane,direction,",
     );
+    let (id_toml, id_json) = (s.s("id.toml"), s.s("id.json"));
+    std::fs::write(&id_json, old).unwrap();
+    check(
+        "id.toml",
+        &[
+            "identify",
+            "--machine",
+            DEMO,
+            "--measured",
+            ZX_CSV,
+            "--param",
+            "z.guideway_normal",
+            "--quiet",
+            "--out",
+            &id_toml,
+            "--report",
+            &id_json,
+        ],
+        "",
+    );
+    assert!(std::fs::read_to_string(&id_json).unwrap().starts_with('{'));
+}
+
+/// `eij report --out` names a folder: an existing one is reused and its report files replaced.
+#[test]
+fn report_folder_is_reused_and_its_files_replaced() {
+    let s = Scratch::new("report-folder");
+    let out = s.s("r");
+    let run = || {
+        let o = eij(&["report", "--measured", ZX_CSV, "--out", &out]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    };
+    run();
+    let html = s.path("r/report.html");
+    std::fs::write(&html, "old").unwrap();
+    run();
+    assert!(std::fs::read_to_string(&html).unwrap().contains("<html"));
+    let tmp = std::fs::read_dir(s.path("r"))
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .any(|e| e.file_name().to_string_lossy().ends_with(".tmp"));
+    assert!(!tmp, "temporary file left in the report folder");
 }
 
 // ---- Outputs of `eij identify` ------------------------------------------------------------
