@@ -7,12 +7,34 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, thiserror::Error)]
 pub enum WriteError {
     /// Creating, writing or renaming the temporary file failed.
-    #[error("{path}: cannot write: {source}")]
+    // The I/O error is part of the message rather than a `source`, so that `{:#}` chains
+    // (`eij: error: …`) do not print it twice.
+    #[error("{path}: cannot write: {cause}")]
     Io {
         /// The output path asked for.
         path: PathBuf,
         /// The underlying I/O error.
-        source: std::io::Error,
+        cause: std::io::Error,
+    },
+    /// The output path names an existing folder.
+    #[error("{path}: is a folder, not a file")]
+    IsAFolder {
+        /// The output path asked for.
+        path: PathBuf,
+    },
+    /// The folder the output should go into does not exist.
+    #[error("{path}: cannot write: folder {} does not exist", folder.display())]
+    NoFolder {
+        /// The output path asked for.
+        path: PathBuf,
+        /// Its parent folder.
+        folder: PathBuf,
+    },
+    /// Two outputs of the same run name the same file.
+    #[error("{path}: given for two outputs of the same run")]
+    SameOutput {
+        /// The output path asked for.
+        path: PathBuf,
     },
     /// The output path names one of the inputs of the same run.
     #[error("{path}: refusing to overwrite an input file")]
@@ -22,25 +44,72 @@ pub enum WriteError {
     },
 }
 
+/// Checks, before anything is computed or written, that every one of `outputs` can be written
+/// by [`write_atomic`]: not a folder, in a folder that exists, not one of `inputs`, and no two
+/// outputs the same file. A run that checks all its outputs first writes all or none of them
+/// (short of a failing disk).
+pub fn check_outputs(outputs: &[&Path], inputs: &[&Path]) -> Result<(), WriteError> {
+    for (i, path) in outputs.iter().enumerate() {
+        if path.is_dir() {
+            return Err(WriteError::IsAFolder {
+                path: path.to_path_buf(),
+            });
+        }
+        let dir = match path.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p,
+            _ => Path::new("."),
+        };
+        if !dir.is_dir() {
+            return Err(WriteError::NoFolder {
+                path: path.to_path_buf(),
+                folder: dir.to_path_buf(),
+            });
+        }
+        if inputs.iter().any(|input| same_file(path, input)) {
+            return Err(WriteError::WouldClobberInput {
+                path: path.to_path_buf(),
+            });
+        }
+        if outputs[..i].iter().any(|other| same_file(path, other)) {
+            return Err(WriteError::SameOutput {
+                path: path.to_path_buf(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Whether two paths name the same file: the same existing file, or the same name in the same
+/// existing folder (for outputs that do not exist yet).
+fn same_file(a: &Path, b: &Path) -> bool {
+    let canonical = |p: &Path| -> Option<PathBuf> {
+        if let Ok(c) = p.canonicalize() {
+            return Some(c);
+        }
+        let dir = match p.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        Some(dir.canonicalize().ok()?.join(p.file_name()?))
+    };
+    match (canonical(a), canonical(b)) {
+        (Some(x), Some(y)) => x == y,
+        _ => a == b,
+    }
+}
+
 /// Writes `bytes` to `path` atomically: first to a temporary file in the same folder, then
 /// renamed over `path`. A failure part-way leaves any previous `path` untouched.
 ///
 /// `inputs` are the files read by the same run; an output that would replace one of them is
-/// refused.
+/// refused, and so is an output path that names a folder or lies in a folder that does not
+/// exist (folders are never created).
 pub fn write_atomic(path: &Path, bytes: &[u8], inputs: &[&Path]) -> Result<(), WriteError> {
-    let io_err = |source| WriteError::Io {
+    let io_err = |cause| WriteError::Io {
         path: path.to_path_buf(),
-        source,
+        cause,
     };
-    if let Ok(out) = path.canonicalize() {
-        for input in inputs {
-            if input.canonicalize().is_ok_and(|i| i == out) {
-                return Err(WriteError::WouldClobberInput {
-                    path: path.to_path_buf(),
-                });
-            }
-        }
-    }
+    check_outputs(&[path], inputs)?;
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
@@ -86,6 +155,14 @@ mod tests {
             .filter(|e| e.file_name().to_string_lossy().ends_with(".tmp"))
             .collect();
         assert!(leftovers.is_empty());
+        let other = dir.join("other.txt");
+        let err = check_outputs(&[&other, &dir.join(".").join("other.txt")], &[]).unwrap_err();
+        assert!(matches!(err, WriteError::SameOutput { .. }), "{err}");
+        let err = write_atomic(&dir, b"x", &[]).unwrap_err();
+        assert!(matches!(err, WriteError::IsAFolder { .. }), "{err}");
+        let err = write_atomic(&dir.join("no/such.txt"), b"x", &[]).unwrap_err();
+        assert!(matches!(err, WriteError::NoFolder { .. }), "{err}");
+        assert!(!other.exists() && !dir.join("no").exists());
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

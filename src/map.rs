@@ -18,6 +18,14 @@ pub enum MapError {
         /// What is wrong.
         message: String,
     },
+    /// A plane that the machine cannot run a circle in.
+    #[error("--plane {plane}: {message}")]
+    Plane {
+        /// The plane given.
+        plane: Plane,
+        /// What is wrong.
+        message: String,
+    },
     /// A grid point the model cannot be evaluated at.
     #[error("at {position}: {message}")]
     Point {
@@ -27,6 +35,10 @@ pub enum MapError {
         message: String,
     },
 }
+
+/// Most grid points of one map (all grids multiplied): bounds time and memory; a compensation
+/// table of 21 × 21 × 21 positions has 9 261.
+pub const MAX_POINTS: usize = 100_000;
 
 /// Grid values of one axis: `min:max:count` in mm (count ≥ 1; count 1 takes `min`).
 #[derive(Debug, Clone, PartialEq)]
@@ -67,6 +79,9 @@ impl AxisGrid {
         if !(lo.is_finite() && hi.is_finite()) || n == 0 || (n > 1 && hi <= lo) {
             return Err(bad("need finite min < max and count ≥ 1"));
         }
+        if n > MAX_POINTS {
+            return Err(bad(&format!("count {n} exceeds {MAX_POINTS} points")));
+        }
         let values_m = (0..n)
             .map(|i| if n == 1 { lo } else { lo + (hi - lo) * i as f64 / (n - 1) as f64 } * 1e-3)
             .collect();
@@ -103,6 +118,15 @@ pub fn eij_map(
     grids: &[AxisGrid],
     spec: &MapSpec,
 ) -> Result<Vec<MapPoint>, MapError> {
+    let (a, b) = spec.plane.axes();
+    for ax in [a, b] {
+        if machine.axis(ax).is_none() {
+            return Err(MapError::Plane {
+                plane: spec.plane,
+                message: format!("the machine {} has no axis {ax}", machine.name),
+            });
+        }
+    }
     let mut index = Vec::new();
     for g in grids {
         let i = machine
@@ -127,6 +151,20 @@ pub fn eij_map(
             });
         }
         index.push(i);
+    }
+    let points = grids
+        .iter()
+        .try_fold(1usize, |n, g| n.checked_mul(g.values_m.len()))
+        .unwrap_or(usize::MAX);
+    if points > MAX_POINTS {
+        return Err(MapError::Grid {
+            spec: grids
+                .iter()
+                .map(|g| g.axis.to_string())
+                .collect::<Vec<_>>()
+                .join(", "),
+            message: format!("{points} grid points, at most {MAX_POINTS}"),
+        });
     }
     let mut positions = vec![machine.reference_pose()];
     for (g, &i) in grids.iter().zip(&index) {

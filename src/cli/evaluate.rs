@@ -18,7 +18,7 @@ pub struct EvaluateArgs {
     pub plane: Option<Plane>,
     /// Set radius, mm (default: the mean internal radius; when given, the data must agree
     /// within 10 %).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub radius_mm: Option<f64>,
     /// Print one JSON object (CONTRACT.md) instead of a table.
     #[arg(long)]
@@ -42,6 +42,9 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<()> {
         if !(r.is_finite() && r > 0.0) {
             anyhow::bail!("--radius-mm {r}: expected a positive number of mm");
         }
+        if r > 3.0 {
+            anyhow::bail!("--radius-mm: {r} mm exceeds the R-Test probe range of ±3 mm");
+        }
     }
     if args.plot.is_some() && args.files.len() != 1 {
         anyhow::bail!(
@@ -49,6 +52,14 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<()> {
             args.files.len()
         );
     }
+    let inputs: Vec<&Path> = args.files.iter().map(PathBuf::as_path).collect();
+    let outputs: Vec<&Path> = args
+        .csv_out
+        .iter()
+        .chain(&args.plot)
+        .map(PathBuf::as_path)
+        .collect();
+    eij::io::check_outputs(&outputs, &inputs)?;
     let opts = EvalOptions {
         plane: args.plane,
         radius_mm: args.radius_mm,
@@ -77,11 +88,9 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<()> {
     };
     if let Some(out) = &args.csv_out {
         let rows: Vec<_> = results.iter().flat_map(table::rows_from_result).collect();
-        let inputs: Vec<&Path> = args.files.iter().map(PathBuf::as_path).collect();
         table::write(out, &rows, &inputs)?;
     }
     if let (Some(plot), Some(svg)) = (&args.plot, plot_svg) {
-        let inputs: Vec<&Path> = args.files.iter().map(PathBuf::as_path).collect();
         eij::io::write_atomic(plot, svg.as_bytes(), &inputs)?;
     }
     if args.json {

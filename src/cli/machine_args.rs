@@ -1,6 +1,5 @@
 //! Options shared by the commands that load a machine.
 
-use anyhow::Context;
 use eij::machine::Machine;
 use std::path::PathBuf;
 
@@ -42,6 +41,16 @@ impl MachineArgs {
                             .join(", ")
                     );
                 }
+                for (a, v) in machine.axes.iter().zip(p) {
+                    let [lo, hi] = a.stroke_m.map(|s| s * 1e3);
+                    if !(v.is_finite() && lo <= *v && *v <= hi) {
+                        anyhow::bail!(
+                            "--position-mm: {} = {v} mm is outside the stroke [{lo}, {hi}] mm of {}",
+                            a.axis,
+                            self.machine.display()
+                        );
+                    }
+                }
                 p.iter().map(|v| v * 1e-3).collect()
             }
         };
@@ -49,12 +58,12 @@ impl MachineArgs {
     }
 }
 
-/// Writes `bytes` atomically to `out`, refusing to overwrite the machine file.
+/// Writes `bytes` atomically to `out`, refusing to overwrite any of `inputs`.
 pub fn write_output(
     out: &std::path::Path,
     bytes: &[u8],
     inputs: &[&std::path::Path],
 ) -> anyhow::Result<()> {
-    eij::io::write_atomic(out, bytes, inputs).with_context(|| "output not written")?;
+    eij::io::write_atomic(out, bytes, inputs)?;
     Ok(())
 }

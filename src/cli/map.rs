@@ -20,10 +20,10 @@ pub struct MapArgs {
     #[arg(long, default_value = "ccw")]
     direction: Direction,
     /// Circle radius, mm.
-    #[arg(long, default_value_t = 2.0)]
+    #[arg(long, default_value_t = 2.0, allow_hyphen_values = true)]
     radius_mm: f64,
     /// Set acceleration, m/s².
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     accel_m_s2: f64,
     /// Grid of one axis, `<axis>=<min>:<max>:<count>` in mm (repeatable; other axes stay at their
     /// reference position).
@@ -56,6 +56,7 @@ pub fn run(args: MapArgs) -> anyhow::Result<()> {
             args.accel_m_s2
         );
     }
+    eij::io::check_outputs(&[&args.out], &[&args.machine])?;
     let machine = Machine::from_file(&args.machine)?;
     let grids = args
         .grids

@@ -35,11 +35,11 @@ struct Common {
     #[arg(long, value_name = "FILE.csv")]
     out: PathBuf,
     /// Output sample rate, Hz.
-    #[arg(long, default_value_t = 10_000.0)]
+    #[arg(long, default_value_t = 10_000.0, allow_hyphen_values = true)]
     rate_hz: f64,
     /// Add Gaussian noise of this standard deviation to the external (R-Test) columns, µm,
     /// to generate realistic test data (the R-Test's U(k=2) = 2.8 µm is σ = 1.4 µm).
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     noise_um: f64,
     /// Seed of the noise.
     #[arg(long, default_value_t = 1)]
@@ -104,6 +104,45 @@ struct MoveArgs {
     jerk_m_s3: f64,
 }
 
+/// Most samples one simulation writes: bounds memory and file size (100 s at 10 kHz).
+const MAX_SAMPLES: f64 = 1e6;
+
+/// Refuses a rate or a length that the output could not hold, and (for circles) a rate too low
+/// for the evaluation to see the circle.
+fn check_samples(common: &Common, sp: &dyn SetPoint, freq_hz: Option<f64>) -> anyhow::Result<()> {
+    let rate = positive("rate-hz", common.rate_hz)?;
+    // Beyond 15 decimals an f64 has no more digits to give.
+    if common.decimals > 15 {
+        bail!(
+            "--decimals: {} is more than the 15 an f64 holds",
+            common.decimals
+        );
+    }
+    let samples = sp.duration_s() * rate;
+    if samples.is_nan() || samples > MAX_SAMPLES {
+        bail!(
+            "--rate-hz {rate}: {:.4} s of simulation would give {samples:.3e} samples, at most \
+             {MAX_SAMPLES:.0e} are written (lower --rate-hz or shorten the test)",
+            sp.duration_s()
+        );
+    }
+    if let Some(f) = freq_hz {
+        let min = eij::rtest::normalise::MIN_SAMPLES_PER_REVOLUTION as f64;
+        if rate < min * f {
+            bail!(
+                "--rate-hz {rate}: {:.1} samples per revolution of the {f:.3} Hz circle, at least \
+                 {min} needed (--rate-hz ≥ {:.0})",
+                rate / f,
+                (min * f).ceil()
+            );
+        }
+    }
+    let mut outputs = vec![common.out.as_path()];
+    outputs.extend(common.plot.as_deref());
+    eij::io::check_outputs(&outputs, &[&common.machine.machine])?;
+    Ok(())
+}
+
 fn positive(name: &str, v: f64) -> anyhow::Result<f64> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
@@ -126,6 +165,7 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
             }
             let mut circle = Circle::new(c.plane, radius_mm * 1e-3, accel, c.direction);
             circle.steady_revolutions = c.revolutions;
+            check_samples(&c.common, &circle, Some(circle.frequency_hz()))?;
             run_setpoint(&c.common, &circle, c.plane, radius_mm)
         }
         Test::Move(m) => {
@@ -136,6 +176,9 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
             let a = positive("accel-m-s2", m.accel_m_s2)?;
             let j = positive("jerk-m-s3", m.jerk_m_s3)?;
             let mv = JerkLimitedMove::new(m.axis, m.distance_mm * 1e-3, v, a, j);
+            check_samples(&m.common, &mv, None)?;
+            run_move(&m.common, &mv)?;
+            // After the run, so that a refused move gives one error line only.
             eprintln!(
                 "move {}: {:.3} mm, peak velocity {:.4} m/s, peak set acceleration {:.3} m/s², {:.4} s",
                 m.axis,
@@ -144,7 +187,7 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
                 mv.peak_accel_m_s2,
                 mv.motion_s()
             );
-            run_move(&m.common, &mv)
+            Ok(())
         }
     }
 }
@@ -220,7 +263,7 @@ fn write_run(
     let run = simulate(cl, sp, rate)?;
     let opts = output::CsvOptions {
         required_only: common.required_only,
-        decimals: common.decimals.min(15),
+        decimals: common.decimals,
         noise_um: common.noise_um,
         seed: common.seed,
     };

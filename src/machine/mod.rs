@@ -282,6 +282,9 @@ impl Machine {
     /// Reads and validates a machine file; extra catalogues are resolved relative to it.
     pub fn from_file(path: &Path) -> Result<Self, MachineError> {
         let file = path.display().to_string();
+        if path.is_dir() {
+            return Err(MachineError::new(&file, "file", "is a folder, not a file"));
+        }
         let text = std::fs::read_to_string(path)
             .map_err(|e| MachineError::new(&file, "file", format!("cannot read: {e}")))?;
         let raw: RawMachine =

@@ -30,17 +30,25 @@ impl TestConditions {
             return Ok(TestConditions::default());
         }
         let name = path.display().to_string();
-        let bad = |key: &str, message: String| RtestError::Conditions {
-            file: name.clone(),
-            key: key.to_string(),
-            message,
-        };
         let text = std::fs::read_to_string(&path).map_err(|e| RtestError::Io {
             path: name.clone(),
             message: e.to_string(),
         })?;
-        let c: TestConditions = toml::from_str(&text)
-            .map_err(|e| bad("TOML", e.message().trim().replace('\n', " ")))?;
+        TestConditions::from_toml_str(&text, &name)
+    }
+
+    /// Parses and validates the text of an `rtest.toml`; `name` stands for the file in error
+    /// messages, which name the key or the line and column.
+    pub fn from_toml_str(text: &str, name: &str) -> Result<TestConditions, RtestError> {
+        let bad = |key: &str, message: String| RtestError::Conditions {
+            file: name.to_string(),
+            key: key.to_string(),
+            message,
+        };
+        let c: TestConditions = toml::from_str(text).map_err(|e| {
+            let m = crate::machine::MachineError::toml(name, text, &e);
+            bad(&m.key, m.message)
+        })?;
         if let Some(r) = c.radius_mm {
             if !(r.is_finite() && r > 0.0 && r <= 3.0) {
                 return Err(bad("radius_mm", format!("{r} must lie in (0, 3] mm")));
@@ -51,6 +59,12 @@ impl TestConditions {
             .is_some_and(|p| p.iter().any(|v| !v.is_finite()))
         {
             return Err(bad("position_mm", "values must be finite".into()));
+        }
+        if c.position_mm.as_ref().is_some_and(Vec::is_empty) {
+            return Err(bad(
+                "position_mm",
+                "empty; give one position per machine axis".into(),
+            ));
         }
         Ok(c)
     }

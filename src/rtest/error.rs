@@ -3,6 +3,25 @@
 
 use std::fmt;
 
+/// File text as it may appear inside a one-line message: control characters (line ends in a
+/// quoted cell, NUL, …) escaped, and long text cut after 40 characters.
+pub fn quote_cell(text: &str) -> String {
+    const MAX_CHARS: usize = 40;
+    let mut out = String::new();
+    for (i, c) in text.chars().enumerate() {
+        if i == MAX_CHARS {
+            out.push('…');
+            break;
+        }
+        if c.is_control() {
+            out.extend(c.escape_default());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
 /// Where in a source a problem was found.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Location {

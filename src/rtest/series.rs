@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use super::error::{Line, Location, RtestError};
+use super::error::{quote_cell, Line, Location, RtestError};
 use crate::axes::Axis;
 
 /// Column names of the internal readings, x, y, z.
@@ -89,13 +89,20 @@ impl CircleSeries {
     /// `{x,y,z}_int_mm`, `{x,y,z}_ext_mm` in any order; other columns ignored.
     pub fn read_csv(path: impl AsRef<Path>) -> Result<Self, RtestError> {
         let path = path.as_ref();
-        let name = path.display().to_string();
         let bytes = read_file(path)?;
+        Self::from_csv_bytes(&path.display().to_string(), &bytes)
+    }
+
+    /// As [`CircleSeries::read_csv`] on the bytes of a file already read (or generated);
+    /// `name` stands for the file in error messages. A leading UTF-8 byte-order mark is dropped.
+    pub fn from_csv_bytes(name: &str, bytes: &[u8]) -> Result<Self, RtestError> {
+        let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+        let name = name.to_string();
         let mut reader = csv::ReaderBuilder::new()
             .has_headers(false)
             .trim(csv::Trim::All)
-            .from_reader(bytes.as_slice());
-        let mut counter = LineCounter::new(&bytes);
+            .from_reader(bytes);
+        let mut counter = LineCounter::new(bytes);
         let mut records = reader.records();
         let header = match records.next() {
             None => {
@@ -114,7 +121,7 @@ impl CircleSeries {
                 if index[k] != usize::MAX {
                     return Err(RtestError::DuplicateColumn {
                         at: header_at,
-                        column: cell.to_string(),
+                        column: quote_cell(cell),
                     });
                 }
                 index[k] = i;
@@ -231,7 +238,6 @@ fn required_columns() -> [&'static str; 7] {
 }
 
 /// Reads a whole file, telling "not found" and "is a folder" apart from other failures.
-/// A UTF-8 byte-order mark (as some spreadsheet exports write) is dropped.
 pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>, RtestError> {
     let name = path.display().to_string();
     match std::fs::metadata(path) {
@@ -250,14 +256,10 @@ pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>, RtestError> {
         Ok(m) if m.is_dir() => return Err(RtestError::NotAFile { path: name }),
         Ok(_) => {}
     }
-    let mut bytes = std::fs::read(path).map_err(|e| RtestError::Io {
+    std::fs::read(path).map_err(|e| RtestError::Io {
         path: name,
         message: e.to_string(),
-    })?;
-    if bytes.starts_with(b"\xEF\xBB\xBF") {
-        bytes.drain(..3);
-    }
-    Ok(bytes)
+    })
 }
 
 /// Physical line numbers (1-based) of byte offsets, counted forward through the file: the CSV
@@ -346,12 +348,12 @@ pub(crate) fn parse_number(
         Err(_) => Err(RtestError::NotANumber {
             at: at(),
             column: column.to_string(),
-            value: text.to_string(),
+            value: quote_cell(text),
         }),
         Ok(v) if !v.is_finite() => Err(RtestError::NotFinite {
             at: at(),
             column: column.to_string(),
-            value: text.to_string(),
+            value: quote_cell(text),
         }),
         Ok(v) => Ok(v),
     }

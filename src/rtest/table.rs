@@ -5,7 +5,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::error::{Location, RtestError};
+use super::error::{quote_cell, Location, RtestError};
 use super::series::{csv_error, parse_number, read_file, LineCounter};
 use super::CircleResult;
 use crate::axes::{Direction, Eij, Plane};
@@ -61,13 +61,20 @@ pub fn rows_from_result(result: &CircleResult) -> Vec<EijRow> {
 /// a finite non-negative standard error (an empty cell means unknown). At least one row.
 pub fn read(path: impl AsRef<Path>) -> Result<Vec<EijRow>, RtestError> {
     let path = path.as_ref();
-    let name = path.display().to_string();
     let bytes = read_file(path)?;
+    from_bytes(&path.display().to_string(), &bytes)
+}
+
+/// As [`read`] on the bytes of a file already read; `name` stands for the file in error
+/// messages. A leading UTF-8 byte-order mark is dropped.
+pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<Vec<EijRow>, RtestError> {
+    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    let name = name.to_string();
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(false)
         .trim(csv::Trim::All)
-        .from_reader(bytes.as_slice());
-    let mut counter = LineCounter::new(&bytes);
+        .from_reader(bytes);
+    let mut counter = LineCounter::new(bytes);
     let mut records = reader.records();
     let expected = || format!("{},{}", COLUMNS.join(","), STD_ERR_COLUMN);
     let header = match records.next() {
@@ -88,13 +95,13 @@ pub fn read(path: impl AsRef<Path>) -> Result<Vec<EijRow>, RtestError> {
             .position(|c| *c == cell)
             .ok_or_else(|| RtestError::UnknownColumn {
                 at: header_at.clone(),
-                column: cell.to_string(),
+                column: quote_cell(cell),
                 expected: expected(),
             })?;
         if index[k] != usize::MAX {
             return Err(RtestError::DuplicateColumn {
                 at: header_at,
-                column: cell.to_string(),
+                column: quote_cell(cell),
             });
         }
         index[k] = i;
@@ -116,7 +123,10 @@ pub fn read(path: impl AsRef<Path>) -> Result<Vec<EijRow>, RtestError> {
         let record = record.map_err(|e| csv_error(&name, &mut counter, e))?;
         let line = counter.line_of_record(&record);
         let at = || Location::file_line(&name, line);
-        let cell = |k: usize| record.get(index[k]).unwrap_or("");
+        // Quoting changes only text that is no valid plane, direction or parameter anyway, and
+        // keeps such text readable and on one line in the error.
+        let raw = |k: usize| record.get(index[k]).unwrap_or("");
+        let cell = |k: usize| quote_cell(raw(k));
         let bad = |k: usize, message: String| RtestError::BadValue {
             at: at(),
             column: COLUMNS[k].to_string(),
@@ -124,7 +134,7 @@ pub fn read(path: impl AsRef<Path>) -> Result<Vec<EijRow>, RtestError> {
         };
         let plane: Plane = cell(0).parse().map_err(|m| bad(0, m))?;
         let direction: Direction = cell(1).parse().map_err(|m| bad(1, m))?;
-        let accel_m_s2 = parse_number(cell(2), &name, line, COLUMNS[2])?;
+        let accel_m_s2 = parse_number(raw(2), &name, line, COLUMNS[2])?;
         if accel_m_s2 <= 0.0 {
             return Err(bad(
                 2,
@@ -138,7 +148,7 @@ pub fn read(path: impl AsRef<Path>) -> Result<Vec<EijRow>, RtestError> {
                 format!("{parameter} is not a parameter of plane {plane}"),
             ));
         }
-        let value = parse_number(cell(4), &name, line, COLUMNS[4])?;
+        let value = parse_number(raw(4), &name, line, COLUMNS[4])?;
         let std_err = match index[5] {
             usize::MAX => None,
             i => match record.get(i).unwrap_or("") {
