@@ -911,7 +911,6 @@ fn quick_identify(s: &Scratch, out: &str, report: &str) -> Vec<String> {
 }
 
 #[test]
-#[ignore = "identify creates missing output folders (src/cli/identify.rs)"]
 fn identify_output_in_a_missing_folder() {
     let s = Scratch::new("id-nowhere");
     let x = s.s("no-such-dir/x.toml");
@@ -928,7 +927,6 @@ fn identify_output_in_a_missing_folder() {
 }
 
 #[test]
-#[ignore = "identify writes --report before it refuses --out (src/cli/identify.rs)"]
 fn identify_output_that_is_a_folder_leaves_no_report() {
     let s = Scratch::new("id-folder");
     let dir = s.s("sub");
@@ -939,7 +937,6 @@ fn identify_output_that_is_a_folder_leaves_no_report() {
 }
 
 #[test]
-#[ignore = "identify accepts the same path for --out and --report (src/cli/identify.rs)"]
 fn identify_out_and_report_the_same_file() {
     let s = Scratch::new("id-same");
     let args = quick_identify(&s, &s.s("id.toml"), &s.s("id.toml"));
@@ -948,7 +945,6 @@ fn identify_out_and_report_the_same_file() {
 }
 
 #[test]
-#[ignore = "identify overwrites the folder's rtest.toml, an input (src/cli/identify.rs)"]
 fn identify_report_over_the_conditions_file() {
     let s = Scratch::new("id-conditions");
     let c = s.s("m/rtest.toml");

@@ -13,6 +13,11 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
+/// The main job's output folder (created when missing) and default outputs.
+const DEFAULT_DIR: &str = "out";
+const DEFAULT_OUT: &str = "out/demo-vmc-identified.toml";
+const DEFAULT_REPORT: &str = "out/demo-vmc-identify-report.json";
+
 /// Arguments of `eij identify`.
 #[derive(Debug, clap::Args)]
 pub struct IdentifyArgs {
@@ -280,6 +285,38 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
     if let Some(p) = &args.position_mm {
         config.position_mm = Some(p.clone());
     }
+    // Inputs of the run (never overwritten): measured files, the rtest.toml of their folders,
+    // the machine and the config. Outputs are checked before any work.
+    let mut inputs: Vec<PathBuf> = measured::expand(&args.measured)?;
+    let conditions: Vec<PathBuf> = inputs
+        .iter()
+        .filter_map(|f| {
+            f.parent()
+                .map(|d| d.join(eij::rtest::conditions::CONDITIONS_FILE))
+        })
+        .filter(|c| c.is_file())
+        .collect();
+    inputs.extend(conditions);
+    inputs.push(args.machine.clone());
+    if let Some(c) = &args.config {
+        inputs.push(c.clone());
+    }
+    let input_refs: Vec<&Path> = inputs.iter().map(|p| p.as_path()).collect();
+    // Only the main job's default output folder is created; any other must exist.
+    if args.out == Path::new(DEFAULT_OUT) || args.report == Path::new(DEFAULT_REPORT) {
+        std::fs::create_dir_all(DEFAULT_DIR)
+            .with_context(|| format!("{DEFAULT_DIR}: cannot create the folder"))?;
+    }
+    let outputs: Vec<&Path> = [
+        Some(args.out.as_path()),
+        Some(args.report.as_path()),
+        args.plot.as_deref(),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    eij::io::check_outputs(&outputs, &input_refs)?;
+
     let prep = prepare(&args.machine, &args.measured, &config, &args.params)?;
     let (result, seconds) = run_identification(&prep, args.quiet)?;
     let toml_text = report::machine_toml(&prep.problem, &result, &prep.provenance)
@@ -291,23 +328,8 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
     };
     let mut json = serde_json::to_vec_pretty(&report_value)?;
     json.push(b'\n');
-    let mut inputs: Vec<PathBuf> = measured::expand(&args.measured)?;
-    inputs.push(args.machine.clone());
-    if let Some(c) = &args.config {
-        inputs.push(c.clone());
-    }
-    let input_refs: Vec<&Path> = inputs.iter().map(|p| p.as_path()).collect();
-    for out in [Some(&args.out), Some(&args.report), args.plot.as_ref()]
-        .into_iter()
-        .flatten()
-    {
-        if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir)
-                .with_context(|| format!("{}: cannot create the folder", dir.display()))?;
-        }
-    }
-    write_output(&args.report, &json, &input_refs)?;
     write_output(&args.out, toml_text.as_bytes(), &input_refs)?;
+    write_output(&args.report, &json, &input_refs)?;
     if let (Some(path), Some(svg)) = (&args.plot, &svg) {
         write_output(path, svg.as_bytes(), &input_refs)?;
     }

@@ -37,6 +37,9 @@ pub struct IdentConfig {
     pub position_mm: Option<Vec<f64>>,
     /// σ of table values without a standard error, µm·s²/m.
     pub table_std_err_um_s2_per_m: Option<f64>,
+    /// The file the settings were read from (for messages).
+    #[serde(skip)]
+    pub source: Option<String>,
 }
 
 impl IdentConfig {
@@ -47,16 +50,18 @@ impl IdentConfig {
             input: name.clone(),
             message: format!("cannot read: {e}"),
         })?;
-        toml::from_str(&text).map_err(|e| IdentError::Test {
-            input: name,
-            message: e.message().trim().replace('\n', " "),
-        })
+        let mut c: IdentConfig = toml::from_str(&text).map_err(|e| {
+            IdentError::Input(crate::machine::MachineError::toml(&name, &text, &e).to_string())
+        })?;
+        c.source = Some(name);
+        Ok(c)
     }
 
     /// Applies the present keys, validating them.
     pub fn apply(&self, s: &mut Settings, m: &mut MeasuredOptions) -> Result<(), IdentError> {
+        let from = self.source.clone().unwrap_or_else(|| "command line".into());
         let bad = |k: &str, v: String| IdentError::Test {
-            input: "settings".into(),
+            input: from.clone(),
             message: format!("{k} = {v} is not allowed"),
         };
         if let Some(v) = self.method {
@@ -94,6 +99,12 @@ impl IdentConfig {
                 }
                 *dst = v;
             }
+        }
+        if m.radius_mm > 3.0 {
+            return Err(bad(
+                "radius_mm",
+                format!("{} (beyond the R-Test's ±3 mm range)", m.radius_mm),
+            ));
         }
         if let Some(v) = self.revolutions {
             if v == 0 {
@@ -152,9 +163,8 @@ impl KnownGood {
             input: name.clone(),
             message: format!("cannot read: {e}"),
         })?;
-        let mut k: KnownGood = toml::from_str(&text).map_err(|e| IdentError::Test {
-            input: name,
-            message: e.message().trim().replace('\n', " "),
+        let mut k: KnownGood = toml::from_str(&text).map_err(|e| {
+            IdentError::Input(crate::machine::MachineError::toml(&name, &text, &e).to_string())
         })?;
         let dir = path.parent().unwrap_or(Path::new("."));
         k.machine = dir.join(&k.machine);

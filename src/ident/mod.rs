@@ -53,6 +53,9 @@ pub enum IdentError {
     /// Reading or evaluating measured data (the message names file and line).
     #[error(transparent)]
     Rtest(#[from] crate::rtest::RtestError),
+    /// An input file that cannot be used (the message names file and place).
+    #[error("{0}")]
+    Input(String),
     /// Nothing to fit.
     #[error("{0}")]
     NoData(String),
@@ -586,6 +589,18 @@ fn distinct_poses(
     let mut index = Vec::with_capacity(tests.len());
     for t in tests {
         let pose = t.position_m.clone().unwrap_or_else(|| default.clone());
+        if pose.len() != machine.axes.len() {
+            return Err(IdentError::Test {
+                input: t.source.clone(),
+                message: format!(
+                    "position_mm (from the folder's rtest.toml, --position-mm or the config) has {} values, the machine {} has {} axes ({})",
+                    pose.len(),
+                    machine.name,
+                    machine.axes.len(),
+                    machine.axes.iter().map(|a| a.axis.name()).collect::<Vec<_>>().join(", ")
+                ),
+            });
+        }
         crate::mbs::Model::assemble(machine, &pose).map_err(|e| IdentError::Test {
             input: t.source.clone(),
             message: format!("test position: {e}"),

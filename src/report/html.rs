@@ -211,6 +211,29 @@ pub fn generate(req: &ReportRequest) -> Result<Vec<PathBuf>, ReportError> {
             message: "exists and is not a folder".into(),
         });
     }
+    // The report folder itself may be created, its parent must exist (like every output).
+    if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
+        if !parent.is_dir() {
+            return Err(ReportError::Output {
+                path: out_name,
+                message: format!("folder {} does not exist", parent.display()),
+            });
+        }
+    }
+    // Never write the report into a folder of measured inputs.
+    if let Ok(o) = out.canonicalize() {
+        if req.measured.iter().any(|m| {
+            m.is_dir()
+                && m.canonicalize()
+                    .is_ok_and(|m| o.starts_with(&m) || m.starts_with(&o))
+        }) {
+            return Err(ReportError::Output {
+                path: out_name,
+                message: "is (or holds) a folder of measured inputs; choose another report folder"
+                    .into(),
+            });
+        }
+    }
     for f in &req.extra_figures {
         if f.file_name.contains(['/', '\\']) || !f.file_name.ends_with(".svg") {
             return Err(ReportError::Output {
@@ -278,10 +301,12 @@ pub fn generate(req: &ReportRequest) -> Result<Vec<PathBuf>, ReportError> {
     let mut inputs: Vec<&Path> = files.iter().map(PathBuf::as_path).collect();
     inputs.extend(req.identify_report.as_deref());
     inputs.extend(req.moves.iter().map(PathBuf::as_path));
-    std::fs::create_dir_all(out).map_err(|e| ReportError::Output {
-        path: out_name,
-        message: format!("cannot create folder: {e}"),
-    })?;
+    std::fs::create_dir(out)
+        .or_else(|e| if out.is_dir() { Ok(()) } else { Err(e) })
+        .map_err(|e| ReportError::Output {
+            path: out_name,
+            message: format!("cannot create folder: {e}"),
+        })?;
     let mut written = Vec::new();
     for (name, bytes) in &outputs {
         let path = out.join(name);
