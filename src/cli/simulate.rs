@@ -208,12 +208,18 @@ fn run_move(common: &Common, mv: &JerkLimitedMove) -> anyhow::Result<()> {
             hi * 1e3
         );
     }
-    // One assembly at the middle of the move (see README: position dependence).
-    let mut mid = pose.clone();
-    mid[i] += mv.distance_m / 2.0;
-    let cl = ClosedLoop::new(&machine, &mid)?;
+    // Re-assembled every 50 mm of travel (eij::sim::move_segments).
+    let rate = positive("rate-hz", common.rate_hz)?;
+    let segments = eij::sim::move_segments(&machine, &pose, i, mv, rate)?;
     let cond = conditions(common, &machine, &pose);
-    write_run(common, &cl, mv, PlotKind::Move(mv.axis), cond)
+    let run = eij::sim::simulate_segments(&segments, mv)?;
+    write_output_files(
+        common,
+        &segments[0].closed_loop,
+        run,
+        PlotKind::Move(mv.axis),
+        cond,
+    )
 }
 
 fn run_setpoint(
@@ -257,10 +263,21 @@ fn write_run(
     cond: Conditions,
 ) -> anyhow::Result<()> {
     let rate = positive("rate-hz", common.rate_hz)?;
+    let run = simulate(cl, sp, rate)?;
+    write_output_files(common, cl, run, kind, cond)
+}
+
+/// Writes the CSV (and the figure) of a finished run.
+fn write_output_files(
+    common: &Common,
+    cl: &ClosedLoop,
+    run: eij::sim::Run,
+    kind: PlotKind,
+    cond: Conditions,
+) -> anyhow::Result<()> {
     if !(common.noise_um.is_finite() && common.noise_um >= 0.0) {
         bail!("--noise-um: {} must be ≥ 0", common.noise_um);
     }
-    let run = simulate(cl, sp, rate)?;
     let opts = output::CsvOptions {
         required_only: common.required_only,
         decimals: common.decimals,
