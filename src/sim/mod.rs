@@ -131,15 +131,31 @@ pub fn simulate_discrete(
     disc: &Discrete,
     setpoint: &dyn SetPoint,
 ) -> Result<Run, SimError> {
-    let h = disc.step_s;
+    run_piecewise(&[(0.0, cl, disc)], setpoint)
+}
+
+/// The time loop over pieces `(from_s, closed loop, discretisation)` sorted by start time: from
+/// rest in equilibrium at the first set point, the state carried across piece boundaries; no
+/// allocation per step.
+fn run_piecewise(
+    pieces: &[(f64, &ClosedLoop, &Discrete)],
+    setpoint: &dyn SetPoint,
+) -> Result<Run, SimError> {
+    let &(_, cl0, disc0) = pieces
+        .first()
+        .ok_or_else(|| SimError::Invalid("no segment to simulate".into()))?;
+    let h = disc0.step_s;
+    if pieces.iter().any(|p| p.2.step_s != h) {
+        return Err(SimError::Invalid(
+            "segments with different step sizes".into(),
+        ));
+    }
     let steps = (setpoint.duration_s() / h).ceil() as usize;
-    let nu = cl.b.ncols();
-    let nx = cl.a.nrows();
-    let ny = cl.c.nrows();
+    let (nu, nx, ny) = (cl0.b.ncols(), cl0.a.nrows(), cl0.c.nrows());
     let mut u_now = DVector::zeros(nu);
     let mut u_next = DVector::zeros(nu);
-    setpoint.eval(0.0, &cl.axes, u_now.as_mut_slice());
-    let mut x = cl.equilibrium(&u_now).ok_or(SimError::NoEquilibrium)?;
+    setpoint.eval(0.0, &cl0.axes, u_now.as_mut_slice());
+    let mut x = cl0.equilibrium(&u_now).ok_or(SimError::NoEquilibrium)?;
     let mut x_next = DVector::zeros(nx);
     let mut run = Run {
         t_s: Vec::with_capacity(steps + 1),
@@ -149,8 +165,13 @@ pub fn simulate_discrete(
         outputs: Vec::with_capacity((steps + 1) * ny),
     };
     let mut y = DVector::zeros(ny);
+    let mut active = 0;
     for k in 0..=steps {
         let t = k as f64 * h;
+        while active + 1 < pieces.len() && pieces[active + 1].0 <= t {
+            active += 1;
+        }
+        let (_, cl, disc) = pieces[active];
         y.gemv(1.0, &cl.c, &x, 0.0);
         y.gemv(1.0, &cl.d, &u_now, 1.0);
         run.t_s.push(t);
@@ -159,7 +180,7 @@ pub fn simulate_discrete(
         if k == steps {
             break;
         }
-        setpoint.eval(t + h, &cl.axes, u_next.as_mut_slice());
+        setpoint.eval(t + h, &cl0.axes, u_next.as_mut_slice());
         x_next.gemv(1.0, &disc.phi, &x, 0.0);
         x_next.gemv(1.0, &disc.gamma0, &u_now, 1.0);
         x_next.gemv(1.0, &disc.gamma1, &u_next, 1.0);
@@ -187,54 +208,11 @@ pub struct Segment {
 /// (K·v = D·v = 0 for the drive mode v), so both models read the same state alike and only the
 /// stiffness met by the deformation changes. Segments must share one machine and step size.
 pub fn simulate_segments(segments: &[Segment], setpoint: &dyn SetPoint) -> Result<Run, SimError> {
-    let first = segments
-        .first()
-        .ok_or_else(|| SimError::Invalid("no segment to simulate".into()))?;
-    let h = first.discrete.step_s;
-    if segments.iter().any(|s| s.discrete.step_s != h) {
-        return Err(SimError::Invalid(
-            "segments with different step sizes".into(),
-        ));
-    }
-    let cl0 = &first.closed_loop;
-    let steps = (setpoint.duration_s() / h).ceil() as usize;
-    let (nu, nx, ny) = (cl0.b.ncols(), cl0.a.nrows(), cl0.c.nrows());
-    let mut u_now = DVector::zeros(nu);
-    let mut u_next = DVector::zeros(nu);
-    setpoint.eval(0.0, &cl0.axes, u_now.as_mut_slice());
-    let mut x = cl0.equilibrium(&u_now).ok_or(SimError::NoEquilibrium)?;
-    let mut x_next = DVector::zeros(nx);
-    let mut run = Run {
-        t_s: Vec::with_capacity(steps + 1),
-        nu,
-        ny,
-        inputs: Vec::with_capacity((steps + 1) * nu),
-        outputs: Vec::with_capacity((steps + 1) * ny),
-    };
-    let mut y = DVector::zeros(ny);
-    let mut active = 0;
-    for k in 0..=steps {
-        let t = k as f64 * h;
-        while active + 1 < segments.len() && segments[active + 1].from_s <= t {
-            active += 1;
-        }
-        let seg = &segments[active];
-        y.gemv(1.0, &seg.closed_loop.c, &x, 0.0);
-        y.gemv(1.0, &seg.closed_loop.d, &u_now, 1.0);
-        run.t_s.push(t);
-        run.inputs.extend_from_slice(u_now.as_slice());
-        run.outputs.extend_from_slice(y.as_slice());
-        if k == steps {
-            break;
-        }
-        setpoint.eval(t + h, &cl0.axes, u_next.as_mut_slice());
-        x_next.gemv(1.0, &seg.discrete.phi, &x, 0.0);
-        x_next.gemv(1.0, &seg.discrete.gamma0, &u_now, 1.0);
-        x_next.gemv(1.0, &seg.discrete.gamma1, &u_next, 1.0);
-        std::mem::swap(&mut x, &mut x_next);
-        std::mem::swap(&mut u_now, &mut u_next);
-    }
-    Ok(run)
+    let pieces: Vec<(f64, &ClosedLoop, &Discrete)> = segments
+        .iter()
+        .map(|s| (s.from_s, &s.closed_loop, &s.discrete))
+        .collect();
+    run_piecewise(&pieces, setpoint)
 }
 
 /// Longest stretch of a move simulated on one assembly of the model, m (see [`move_segments`]).
