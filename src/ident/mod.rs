@@ -765,6 +765,22 @@ pub struct IdentResult {
     pub machine: Machine,
 }
 
+/// Best parameters, iterations and whether the solver converged (rather than ran out of
+/// iterations), from a finished argmin state.
+fn outcome<S: State<Param = DVector<f64>>>(
+    st: &S,
+) -> Result<(DVector<f64>, u64, bool), IdentError> {
+    let converged = matches!(
+        st.get_termination_reason(),
+        Some(TerminationReason::SolverConverged)
+    );
+    let p = st
+        .get_best_param()
+        .cloned()
+        .ok_or_else(|| IdentError::Optimiser("no result".into()))?;
+    Ok((p, st.get_iter(), converged))
+}
+
 /// Column norms below this fraction of the largest mark a parameter the tests do not see.
 const UNIDENTIFIABLE: f64 = 1e-6;
 
@@ -829,16 +845,7 @@ pub fn identify(
                 .add_observer(observer, ObserverMode::Always)
                 .run()
                 .map_err(|e| IdentError::Optimiser(format!("{e:#}")))?;
-            let st = res.state();
-            let converged = matches!(
-                st.get_termination_reason(),
-                Some(TerminationReason::SolverConverged)
-            );
-            let p = st
-                .get_best_param()
-                .cloned()
-                .ok_or_else(|| IdentError::Optimiser("no result".into()))?;
-            (p, st.get_iter(), converged)
+            outcome(res.state())?
         }
         Method::NelderMead => {
             let mut simplex = vec![start.clone()];
@@ -862,16 +869,8 @@ pub fn identify(
                 .add_observer(observer, ObserverMode::Always)
                 .run()
                 .map_err(|e| IdentError::Optimiser(format!("{e:#}")))?;
-            let st = res.state();
-            let converged = matches!(
-                st.get_termination_reason(),
-                Some(TerminationReason::SolverConverged)
-            );
-            let p = st
-                .get_best_param()
-                .cloned()
-                .ok_or_else(|| IdentError::Optimiser("no result".into()))?;
-            (p.map(|t| t.clamp(lo, hi)), st.get_iter(), converged)
+            let (p, iterations, converged) = outcome(res.state())?;
+            (p.map(|t| t.clamp(lo, hi)), iterations, converged)
         }
     };
     let mut theta = theta0.clone();
