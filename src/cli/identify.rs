@@ -206,7 +206,8 @@ fn print_result(prep: &Prepared, result: &IdentResult, seconds: f64) {
         }
     }
     println!(
-        "\n  test                   EIJ   measured ± σ       catalogue (ratio)   identified (ratio)   (µm·s²/m)"
+        "\n  {:<36} EIJ   measured ± σ       catalogue (ratio)   identified (ratio)   (µm·s²/m)",
+        "test"
     );
     for (i, t) in p.tests().iter().enumerate() {
         for (e, (m, s)) in &t.measured {
@@ -226,7 +227,7 @@ fn print_result(prep: &Prepared, result: &IdentResult, seconds: f64) {
                 }
             };
             println!(
-                "  {:<22} {} {:>8.3} ± {:<6.3}  {:>8.3} ({})     {:>8.3} ({})",
+                "  {:<36} {} {:>8.3} ± {:<6.3}  {:>8.3} ({})     {:>8.3} ({})",
                 t.label(),
                 e,
                 m,

@@ -206,12 +206,23 @@ pub struct TestCase {
 }
 
 impl TestCase {
-    /// A short label: `zx ccw 5.00 m/s²`.
+    /// A short label: `zx ccw 5.00 m/s²`, with the circle centre where one is given
+    /// (`zx ccw 5.00 m/s² @ 150,-100,0 mm`).
     pub fn label(&self) -> String {
-        format!(
+        let base = format!(
             "{} {} {:.2} m/s²",
             self.plane, self.direction, self.accel_m_s2
-        )
+        );
+        match &self.position_m {
+            Some(p) => format!(
+                "{base} @ {} mm",
+                p.iter()
+                    .map(|v| format!("{:.0}", v * 1e3))
+                    .collect::<Vec<_>>()
+                    .join(",")
+            ),
+            None => base,
+        }
     }
 }
 
