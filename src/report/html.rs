@@ -165,14 +165,7 @@ fn evaluate_file(path: &Path, index: usize) -> Result<CircleEntry, ReportError> 
 
 fn read_identification(path: &Path) -> Result<(IdentReport, Figure), ReportError> {
     let name = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| ReportError::Read {
-        path: name.clone(),
-        message: if e.kind() == std::io::ErrorKind::NotFound {
-            "file not found".into()
-        } else {
-            e.to_string()
-        },
-    })?;
+    let bytes = super::read_file(path)?;
     let value: serde_json::Value =
         serde_json::from_slice(&bytes).map_err(|e| ReportError::BadInput {
             source_name: name.clone(),

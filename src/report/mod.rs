@@ -34,6 +34,18 @@ pub use ident_plot::identification_svg;
 pub use map_plot::map_svg;
 pub use move_plot::{move_svg, MoveData};
 
+/// Reads an input file of the report; a missing file says so in plain words.
+pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>, ReportError> {
+    std::fs::read(path).map_err(|e| ReportError::Read {
+        path: path.display().to_string(),
+        message: if e.kind() == std::io::ErrorKind::NotFound {
+            "file not found".into()
+        } else {
+            e.to_string()
+        },
+    })
+}
+
 /// Errors of the figures and the report; every message is one line naming the file or key.
 #[derive(Debug, thiserror::Error)]
 pub enum ReportError {

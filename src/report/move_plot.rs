@@ -49,14 +49,7 @@ impl MoveData {
         if path.is_dir() {
             return Err(bad("is a folder, expected a move CSV file".into()));
         }
-        let bytes = std::fs::read(path).map_err(|e| ReportError::Read {
-            path: name.clone(),
-            message: if e.kind() == std::io::ErrorKind::NotFound {
-                "file not found".into()
-            } else {
-                e.to_string()
-            },
-        })?;
+        let bytes = super::read_file(path)?;
         let mut reader = csv::ReaderBuilder::new()
             .trim(csv::Trim::All)
             .from_reader(bytes.as_slice());

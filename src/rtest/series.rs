@@ -115,30 +115,9 @@ impl CircleSeries {
         };
         let header_at = Location::file_line(&name, counter.line_of_record(&header));
         let required = required_columns();
-        let mut index = [usize::MAX; 7];
-        for (i, cell) in header.iter().enumerate() {
-            if let Some(k) = required.iter().position(|r| *r == cell) {
-                if index[k] != usize::MAX {
-                    return Err(RtestError::DuplicateColumn {
-                        at: header_at,
-                        column: quote_cell(cell),
-                    });
-                }
-                index[k] = i;
-            }
-        }
-        let missing: Vec<String> = required
-            .iter()
-            .zip(index)
-            .filter(|(_, i)| *i == usize::MAX)
-            .map(|(r, _)| r.to_string())
-            .collect();
-        if !missing.is_empty() {
-            return Err(RtestError::MissingColumns {
-                at: header_at,
-                columns: missing,
-            });
-        }
+        // Other columns (set points, accelerations, …) are ignored.
+        let index = column_indices(&header, &required, &header_at, |_| Ok(()))?;
+        require_columns(&index, &required, &header_at)?;
         let mut cols: [Vec<f64>; 7] = Default::default();
         let mut lines = Vec::new();
         for record in records {
@@ -222,6 +201,52 @@ impl CircleSeries {
             source: self.source.clone(),
             line: Some(line),
         }
+    }
+}
+
+/// The index of each `wanted` column in `header` (`usize::MAX` when absent); a wanted column
+/// given twice is an error, any other column goes to `other` (to be ignored or refused).
+pub(crate) fn column_indices<const N: usize>(
+    header: &csv::StringRecord,
+    wanted: &[&str; N],
+    at: &Location,
+    mut other: impl FnMut(&str) -> Result<(), RtestError>,
+) -> Result<[usize; N], RtestError> {
+    let mut index = [usize::MAX; N];
+    for (i, cell) in header.iter().enumerate() {
+        match wanted.iter().position(|w| *w == cell) {
+            Some(k) if index[k] != usize::MAX => {
+                return Err(RtestError::DuplicateColumn {
+                    at: at.clone(),
+                    column: quote_cell(cell),
+                })
+            }
+            Some(k) => index[k] = i,
+            None => other(cell)?,
+        }
+    }
+    Ok(index)
+}
+
+/// Fails naming every one of `names` whose `index` is absent.
+pub(crate) fn require_columns(
+    index: &[usize],
+    names: &[&str],
+    at: &Location,
+) -> Result<(), RtestError> {
+    let missing: Vec<String> = names
+        .iter()
+        .zip(index)
+        .filter(|(_, i)| **i == usize::MAX)
+        .map(|(n, _)| n.to_string())
+        .collect();
+    if missing.is_empty() {
+        Ok(())
+    } else {
+        Err(RtestError::MissingColumns {
+            at: at.clone(),
+            columns: missing,
+        })
     }
 }
 

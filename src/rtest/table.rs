@@ -6,7 +6,9 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::error::{quote_cell, Location, RtestError};
-use super::series::{csv_error, parse_number, read_file, LineCounter};
+use super::series::{
+    column_indices, csv_error, parse_number, read_file, require_columns, LineCounter,
+};
 use super::CircleResult;
 use crate::axes::{Direction, Eij, Plane};
 
@@ -87,37 +89,23 @@ pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<Vec<EijRow>, RtestError> {
         Some(r) => r.map_err(|e| csv_error(&name, &mut counter, e))?,
     };
     let header_at = Location::file_line(&name, counter.line_of_record(&header));
-    let mut index = [usize::MAX; 6];
-    for (i, cell) in header.iter().enumerate() {
-        let k = COLUMNS
-            .iter()
-            .chain([&STD_ERR_COLUMN])
-            .position(|c| *c == cell)
-            .ok_or_else(|| RtestError::UnknownColumn {
-                at: header_at.clone(),
-                column: quote_cell(cell),
-                expected: expected(),
-            })?;
-        if index[k] != usize::MAX {
-            return Err(RtestError::DuplicateColumn {
-                at: header_at,
-                column: quote_cell(cell),
-            });
-        }
-        index[k] = i;
-    }
-    let missing: Vec<String> = COLUMNS
-        .iter()
-        .zip(index)
-        .filter(|(_, i)| *i == usize::MAX)
-        .map(|(c, _)| c.to_string())
-        .collect();
-    if !missing.is_empty() {
-        return Err(RtestError::MissingColumns {
-            at: header_at,
-            columns: missing,
-        });
-    }
+    let wanted = [
+        COLUMNS[0],
+        COLUMNS[1],
+        COLUMNS[2],
+        COLUMNS[3],
+        COLUMNS[4],
+        STD_ERR_COLUMN,
+    ];
+    // An unknown column is refused: a typo must not drop the standard errors silently.
+    let index = column_indices(&header, &wanted, &header_at, |cell| {
+        Err(RtestError::UnknownColumn {
+            at: header_at.clone(),
+            column: quote_cell(cell),
+            expected: expected(),
+        })
+    })?;
+    require_columns(&index[..COLUMNS.len()], &COLUMNS, &header_at)?;
     let mut rows = Vec::new();
     for record in records {
         let record = record.map_err(|e| csv_error(&name, &mut counter, e))?;
