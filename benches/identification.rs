@@ -6,8 +6,9 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use eij::ident::measured::{load, MeasuredOptions};
-use eij::ident::{identify, Parameter, Problem, Settings, SolverKind};
+use eij::ident::{identify, Parameter, Problem, Settings};
 use eij::machine::Machine;
+use eij::predict::{SimSettings, SolverKind};
 use std::path::Path;
 
 fn bench(c: &mut Criterion) {
@@ -25,7 +26,10 @@ fn bench(c: &mut Criterion) {
         ("time domain", SolverKind::Time),
     ] {
         let settings = Settings {
-            solver,
+            simulation: SimSettings {
+                solver,
+                ..SimSettings::default()
+            },
             ..Settings::default()
         };
         let problem = Problem::new(

@@ -7,7 +7,7 @@
 //! The module tree follows the data path:
 //!
 //! ```text
-//! machine ─► mbs ─► control ─► sim ─► rtest ─► ident ─► report
+//! machine ─► mbs ─► control ─► sim ─► rtest ─► predict ─► ident ─► report
 //! ```
 //!
 //! * [`machine`]: the validated machine description (bodies, axes, guideways, drives, control),
@@ -17,6 +17,9 @@
 //! * [`control`]: drives under cascaded P-PI control; the closed loop in state space.
 //! * [`sim`]: set points (circle, jerk-limited move) and exact time-domain discretisation.
 //! * [`rtest`]: reading and evaluating R-Test circle tests into EIJ with standard errors.
+//! * [`predict`]: simulated circle tests evaluated like measured ones: the EIJ a model predicts.
+//! * [`ident`]: stiffness reduction factors fitted to measured EIJ, with their uncertainty.
+//! * [`map`]: EIJ over the workspace; [`report`]: figures and the HTML report.
 //!
 //! Equation numbers (eq. 3–6, section 2.2/2.3) refer to the paper on acceleration correlated
 //! position errors measured with the R-Test that this tool implements and extends.
@@ -28,6 +31,7 @@ pub mod io;
 pub mod machine;
 pub mod map;
 pub mod mbs;
+pub mod predict;
 pub mod report;
 pub mod rtest;
 pub mod sim;

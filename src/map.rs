@@ -1,17 +1,17 @@
 //! EIJ maps over the workspace: the position-dependent model evaluated on a grid of axis
 //! positions (harmonic steady state, the same simulation and evaluation as the
-//! identification), as a compensation table position → EIJ.
+//! identification: [`crate::predict`]), as a compensation table position → EIJ.
 
 use crate::axes::{Axis, Direction, Eij, Plane};
-use crate::ident::{simulated_eij, Settings, TestCase};
 use crate::machine::Machine;
+use crate::predict::{simulated_eij, CircleTest, PredictError, SimSettings};
 use std::collections::BTreeMap;
 
 /// Errors of a map.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MapError {
     /// A grid that does not fit the machine.
-    #[error("--grid {spec}: {message}")]
+    #[error("grid {spec}: {message}")]
     Grid {
         /// The grid specification given.
         spec: String,
@@ -19,7 +19,7 @@ pub enum MapError {
         message: String,
     },
     /// A plane that the machine cannot run a circle in.
-    #[error("--plane {plane}: {message}")]
+    #[error("plane {plane}: {message}")]
     Plane {
         /// The plane given.
         plane: Plane,
@@ -27,11 +27,14 @@ pub enum MapError {
         message: String,
     },
     /// A grid point the model cannot be evaluated at.
-    #[error("at {position}: {message}")]
-    Point {
-        /// The position, mm.
-        position: String,
-        /// What failed.
+    #[error(transparent)]
+    Predict(#[from] PredictError),
+    /// A map table that cannot be read.
+    #[error("{at}: {message}")]
+    Table {
+        /// File and line.
+        at: String,
+        /// What is wrong.
         message: String,
     },
 }
@@ -180,29 +183,24 @@ pub fn eij_map(
             .collect();
     }
     // The same simulation and evaluation as the identification, one test per grid point.
-    let tests: Vec<TestCase> = positions
+    let tests: Vec<CircleTest> = positions
         .iter()
-        .map(|p| TestCase {
-            source: format!(
-                "map at {} mm",
-                p.iter()
-                    .map(|v| format!("{:.1}", v * 1e3))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ),
-            plane: spec.plane,
-            direction: spec.direction,
-            radius_mm: spec.radius_m * 1e3,
-            accel_m_s2: spec.accel_m_s2,
-            position_m: Some(p.clone()),
-            measured: BTreeMap::new(),
+        .map(|p| {
+            CircleTest::new(
+                spec.plane,
+                spec.direction,
+                spec.radius_m * 1e3,
+                spec.accel_m_s2,
+            )
+            .at(p.clone())
         })
         .collect();
-    let sims =
-        simulated_eij(machine, &tests, &Settings::default()).map_err(|e| MapError::Point {
-            position: "grid".into(),
-            message: e.to_string(),
-        })?;
+    let sims = simulated_eij(
+        std::slice::from_ref(machine),
+        &tests,
+        &SimSettings::default(),
+    )?
+    .remove(0);
     Ok(positions
         .into_iter()
         .zip(sims)
@@ -246,8 +244,8 @@ pub fn to_csv(machine: &Machine, spec: &MapSpec, points: &[MapPoint]) -> String 
 /// positions in x, y, z order.
 pub fn read_csv(path: &std::path::Path) -> Result<(MapSpec, Vec<MapPoint>), MapError> {
     let name = path.display().to_string();
-    let bad = |line: usize, m: String| MapError::Point {
-        position: format!("{name}:{line}"),
+    let bad = |line: usize, m: String| MapError::Table {
+        at: format!("{name}:{line}"),
         message: m,
     };
     let text = std::fs::read_to_string(path).map_err(|e| bad(0, format!("cannot read: {e}")))?;

@@ -2,8 +2,8 @@
 
 use eij::axes::{Direction, Plane};
 use eij::control::ClosedLoop;
-use eij::ident::{simulated_eij, Settings, SolverKind, TestCase};
 use eij::machine::Machine;
+use eij::predict::{simulated_eij, CircleTest, SimSettings, SolverKind};
 use eij::sim::harmonic;
 use eij::sim::setpoint::Circle;
 use eij::sim::simulate;
@@ -21,36 +21,31 @@ fn harmonic_and_time_domain_eij_agree_for_every_plane_direction_and_acceleration
     for plane in Plane::ALL {
         for direction in Direction::ALL {
             for accel_m_s2 in [1.0, 2.0, 5.0, 8.0, 10.0] {
-                tests.push(TestCase {
-                    source: "agreement".into(),
-                    plane,
-                    direction,
-                    radius_mm: 2.0,
-                    accel_m_s2,
-                    position_m: None,
-                    measured: Default::default(),
-                });
+                tests.push(CircleTest::new(plane, direction, 2.0, accel_m_s2));
             }
         }
     }
+    let machines = [machine];
     let time = simulated_eij(
-        &machine,
+        &machines,
         &tests,
-        &Settings {
+        &SimSettings {
             solver: SolverKind::Time,
-            ..Settings::default()
+            ..SimSettings::default()
         },
     )
-    .unwrap();
+    .unwrap()
+    .remove(0);
     let harm = simulated_eij(
-        &machine,
+        &machines,
         &tests,
-        &Settings {
+        &SimSettings {
             solver: SolverKind::Harmonic,
-            ..Settings::default()
+            ..SimSettings::default()
         },
     )
-    .unwrap();
+    .unwrap()
+    .remove(0);
     let mut worst: f64 = 0.0;
     for ((t, h), case) in time.iter().zip(&harm).zip(&tests) {
         assert_eq!(t.len(), 6);

@@ -1,8 +1,9 @@
 //! Identification against synthetic data with known reduction factors.
 
 use eij::axes::{Direction, Plane};
-use eij::ident::{identify, simulated_eij, IdentError, Parameter, Problem, Settings, TestCase};
+use eij::ident::{identify, IdentError, Parameter, Problem, Settings, TestCase};
 use eij::machine::Machine;
+use eij::predict::{simulated_eij, CircleTest};
 use std::path::Path;
 
 fn root() -> &'static Path {
@@ -19,11 +20,8 @@ fn conditions(planes: &[Plane], accels: &[f64]) -> Vec<TestCase> {
         for &accel_m_s2 in accels {
             v.push(TestCase {
                 source: format!("synthetic {plane} {accel_m_s2}"),
-                plane,
-                direction: Direction::Ccw,
-                radius_mm: 2.0,
-                accel_m_s2,
-                position_m: Some(vec![0.15, -0.1, 0.0]),
+                circle: CircleTest::new(plane, Direction::Ccw, 2.0, accel_m_s2)
+                    .at(vec![0.15, -0.1, 0.0]),
                 measured: Default::default(),
             });
         }
@@ -33,7 +31,10 @@ fn conditions(planes: &[Plane], accels: &[f64]) -> Vec<TestCase> {
 
 /// "Measured" EIJ: the model with the true factors, evaluated exactly as identification does.
 fn synthetic(truth: &Machine, tests: &mut [TestCase], settings: &Settings) {
-    let sims = simulated_eij(truth, tests, settings).unwrap();
+    let circles: Vec<CircleTest> = tests.iter().map(|t| t.circle.clone()).collect();
+    let sims = simulated_eij(std::slice::from_ref(truth), &circles, &settings.simulation)
+        .unwrap()
+        .remove(0);
     for (t, sim) in tests.iter_mut().zip(sims) {
         t.measured = sim.into_iter().map(|(k, v)| (k, (v, 0.02))).collect();
     }
@@ -143,7 +144,7 @@ fn tests_without_values_or_in_a_plane_the_model_lacks_are_refused() {
     assert_eq!(err.to_string(), "synthetic zx 4: no EIJ values");
     let single = Machine::from_file(&root().join("machines/reference/single-axis.toml")).unwrap();
     let mut tests = conditions(&[Plane::Xy], &[4.0]);
-    tests[0].position_m = None;
+    tests[0].circle.position_m = None;
     tests[0].measured.insert(
         eij::axes::Eij::new(eij::axes::Axis::X, eij::axes::Axis::X),
         (-1.0, 0.02),

@@ -1,9 +1,9 @@
 //! EIJ maps over the workspace.
 
 use eij::axes::{Axis, Direction, Eij, Plane};
-use eij::ident::{simulated_eij, Settings, TestCase};
 use eij::machine::Machine;
 use eij::map::{eij_map, read_csv, to_csv, AxisGrid, MapSpec};
+use eij::predict::{simulated_eij, CircleTest, SimSettings};
 use std::path::Path;
 
 fn demo() -> Machine {
@@ -30,17 +30,9 @@ fn a_map_point_equals_the_identification_simulation_at_that_position() {
     let points = eij_map(&m, &grids, &spec()).unwrap();
     assert_eq!(points.len(), 3);
     assert_eq!(points[2].position_m, vec![0.2, 0.1, 0.0]);
-    let test = TestCase {
-        source: "map".into(),
-        plane: Plane::Zx,
-        direction: Direction::Ccw,
-        radius_mm: 2.0,
-        accel_m_s2: 5.0,
-        position_m: Some(vec![0.2, 0.1, 0.0]),
-        measured: Default::default(),
-    };
-    let sim = simulated_eij(&m, &[test], &Settings::default()).unwrap();
-    for (e, v) in &sim[0] {
+    let test = CircleTest::new(Plane::Zx, Direction::Ccw, 2.0, 5.0).at(vec![0.2, 0.1, 0.0]);
+    let sim = simulated_eij(&[m], &[test], &SimSettings::default()).unwrap();
+    for (e, v) in &sim[0][0] {
         assert!((points[2].eij[e] - v).abs() < 1e-12, "{e}");
     }
 }

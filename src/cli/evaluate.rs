@@ -72,10 +72,11 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<()> {
     let results = series
         .iter()
         .map(|s| rtest::evaluate(s, &opts))
-        .collect::<Result<Vec<_>, _>>()?;
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(super::advice::evaluate)?;
     let pooled = if args.pooled {
         let refs: Vec<&CircleSeries> = series.iter().collect();
-        Some(rtest::evaluate_pooled(&refs, &opts)?)
+        Some(rtest::evaluate_pooled(&refs, &opts).map_err(super::advice::evaluate)?)
     } else {
         None
     };

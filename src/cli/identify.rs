@@ -122,7 +122,8 @@ fn prepare(
             .collect::<Result<Vec<_>, _>>()?
     };
     let tests = measured::load(measured_paths, &mopts)?;
-    let problem = Problem::new(machine, params, tests, settings)?;
+    let problem =
+        Problem::new(machine, params, tests, settings).map_err(super::advice::identify)?;
     let provenance = Provenance::now(
         machine_path.display().to_string(),
         measured::expand(measured_paths)?
@@ -165,7 +166,10 @@ fn run_identification(prep: &Prepared, quiet: bool) -> anyhow::Result<(IdentResu
     if let Some(b) = bar {
         b.finish_and_clear();
     }
-    Ok((result?, start.elapsed().as_secs_f64()))
+    Ok((
+        result.map_err(super::advice::identify)?,
+        start.elapsed().as_secs_f64(),
+    ))
 }
 
 fn print_result(prep: &Prepared, result: &IdentResult, seconds: f64) {

@@ -62,14 +62,15 @@ pub fn run(args: MapArgs) -> anyhow::Result<()> {
         .grids
         .iter()
         .map(|g| AxisGrid::parse(g))
-        .collect::<Result<Vec<_>, _>>()?;
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(super::advice::map)?;
     let spec = MapSpec {
         plane: args.plane,
         direction: args.direction,
         radius_m: args.radius_mm * 1e-3,
         accel_m_s2: args.accel_m_s2,
     };
-    let points = eij_map(&machine, &grids, &spec)?;
+    let points = eij_map(&machine, &grids, &spec).map_err(super::advice::map)?;
     let axes: Vec<_> = machine.axes.iter().map(|a| a.axis).collect();
     let svg = match &args.plot {
         Some(_) => Some(eij::report::map_svg(&machine.name, &axes, &spec, &points)?),

@@ -2,6 +2,7 @@
 
 use clap::{Parser, Subcommand};
 
+mod advice;
 pub mod evaluate;
 mod export;
 mod identify;

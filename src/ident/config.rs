@@ -50,9 +50,8 @@ impl IdentConfig {
             input: name.clone(),
             message: format!("cannot read: {e}"),
         })?;
-        let mut c: IdentConfig = toml::from_str(&text).map_err(|e| {
-            IdentError::Input(crate::machine::MachineError::toml(&name, &text, &e).to_string())
-        })?;
+        let mut c: IdentConfig = toml::from_str(&text)
+            .map_err(|e| crate::machine::MachineError::toml(&name, &text, &e))?;
         c.source = Some(name);
         Ok(c)
     }
@@ -66,26 +65,22 @@ impl IdentConfig {
         };
         if let Some(v) = self.method {
             s.method = v;
-            // Nelder–Mead needs far more (cheaper) iterations than Levenberg–Marquardt.
-            if v == Method::NelderMead && self.max_iters.is_none() {
-                s.max_iters = 2000;
-            }
         }
         if let Some(v) = self.solver {
-            s.solver = v;
+            s.simulation.solver = v;
         }
         if let Some(v) = self.max_iters {
             if v == 0 {
                 return Err(bad("max_iters", v.to_string()));
             }
-            s.max_iters = v;
+            s.max_iters = Some(v);
         }
         for (k, src, dst) in [
             ("min_factor", self.min_factor, &mut s.min_factor),
             ("tol_cost", self.tol_cost, &mut s.tol_cost),
             ("tol_step", self.tol_step, &mut s.tol_step),
             ("max_factor", self.max_factor, &mut s.max_factor),
-            ("rate_hz", self.rate_hz, &mut s.rate_hz),
+            ("rate_hz", self.rate_hz, &mut s.simulation.rate_hz),
             ("radius_mm", self.radius_mm, &mut m.radius_mm),
             (
                 "table_std_err_um_s2_per_m",
@@ -110,13 +105,13 @@ impl IdentConfig {
             if v == 0 {
                 return Err(bad("revolutions", v.to_string()));
             }
-            s.revolutions = v;
+            s.simulation.revolutions = v;
         }
         if let Some(p) = &self.position_mm {
             if p.iter().any(|v| !v.is_finite()) {
                 return Err(bad("position_mm", format!("{p:?}")));
             }
-            s.position_m = Some(p.iter().map(|v| v * 1e-3).collect());
+            s.simulation.position_m = Some(p.iter().map(|v| v * 1e-3).collect());
         }
         if s.min_factor >= s.max_factor {
             return Err(bad(
@@ -163,9 +158,8 @@ impl KnownGood {
             input: name.clone(),
             message: format!("cannot read: {e}"),
         })?;
-        let mut k: KnownGood = toml::from_str(&text).map_err(|e| {
-            IdentError::Input(crate::machine::MachineError::toml(&name, &text, &e).to_string())
-        })?;
+        let mut k: KnownGood = toml::from_str(&text)
+            .map_err(|e| crate::machine::MachineError::toml(&name, &text, &e))?;
         let dir = path.parent().unwrap_or(Path::new("."));
         k.machine = dir.join(&k.machine);
         k.measured = k.measured.iter().map(|m| dir.join(m)).collect();

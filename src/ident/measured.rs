@@ -1,31 +1,13 @@
 //! Measured EIJ for identification, from R-Test CSV files (through the evaluation), folders of
 //! them, or EIJ tables (CONTRACT.md).
 
+pub use super::settings::MeasuredOptions;
 use super::{IdentError, TestCase};
+use crate::predict::CircleTest;
 use crate::rtest::conditions::TestConditions;
 use crate::rtest::{self, table, CircleSeries, EvalOptions};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-
-/// How to read measured data.
-#[derive(Debug, Clone, PartialEq)]
-pub struct MeasuredOptions {
-    /// Set radius of the circle tests, mm: R-Test series are evaluated with it, table tests
-    /// (tables carry no radius) take it, and the simulated tests run and are evaluated with it,
-    /// so that measurement and model are compared like with like.
-    pub radius_mm: f64,
-    /// σ for table values without a standard error, µm·s²/m.
-    pub table_std_err: f64,
-}
-
-impl Default for MeasuredOptions {
-    fn default() -> Self {
-        MeasuredOptions {
-            radius_mm: 2.0,
-            table_std_err: 0.05,
-        }
-    }
-}
 
 /// Whether a CSV file is an EIJ table (has a `parameter` column) rather than a time series.
 fn is_table(path: &Path) -> bool {
@@ -88,11 +70,13 @@ fn load_files(
                         "{name} ({} {} {} m/s²)",
                         row.plane, row.direction, row.accel_m_s2
                     ),
-                    plane: row.plane,
-                    direction: row.direction,
-                    radius_mm,
-                    accel_m_s2: row.accel_m_s2,
-                    position_m: position_m.clone(),
+                    circle: CircleTest {
+                        plane: row.plane,
+                        direction: row.direction,
+                        radius_mm,
+                        accel_m_s2: row.accel_m_s2,
+                        position_m: position_m.clone(),
+                    },
                     measured: BTreeMap::new(),
                 });
                 case.measured.insert(
@@ -110,11 +94,13 @@ fn load_files(
             let result = rtest::evaluate(&series, &eval).map_err(err)?;
             tests.push(TestCase {
                 source: name.clone(),
-                plane: result.plane,
-                direction: result.direction,
-                radius_mm: result.radius_mm,
-                accel_m_s2: result.accel_m_s2,
-                position_m: position_m.clone(),
+                circle: CircleTest {
+                    plane: result.plane,
+                    direction: result.direction,
+                    radius_mm: result.radius_mm,
+                    accel_m_s2: result.accel_m_s2,
+                    position_m: position_m.clone(),
+                },
                 measured: result
                     .eij
                     .iter()

@@ -34,13 +34,13 @@ impl Provenance {
 
 fn settings_json(s: &Settings) -> Value {
     json!({
-                "method": s.method,
-        "solver": s.solver,
-        "rate_hz": s.rate_hz,
-        "revolutions": s.revolutions,
+        "method": s.method,
+        "solver": s.simulation.solver,
+        "rate_hz": s.simulation.rate_hz,
+        "revolutions": s.simulation.revolutions,
         "min_factor": s.min_factor,
         "max_factor": s.max_factor,
-        "max_iters": s.max_iters,
+        "max_iters": s.max_iters(),
         "tol_cost": s.tol_cost,
         "tol_step": s.tol_step,
         "fd_step": s.fd_step,
@@ -78,10 +78,10 @@ pub fn report_json(problem: &Problem, result: &IdentResult, prov: &Provenance) -
             };
             json!({
                 "source": t.source,
-                "plane": t.plane.name(),
-                "direction": t.direction.name(),
-                "radius_mm": t.radius_mm,
-                "accel_m_s2": t.accel_m_s2,
+                "plane": t.circle.plane.name(),
+                "direction": t.circle.direction.name(),
+                "radius_mm": t.circle.radius_mm,
+                "accel_m_s2": t.circle.accel_m_s2,
                 "measured": eij_json(&measured),
                 "measured_std_err": eij_json(&sigma),
                 "simulated_initial": only_measured(&result.simulated_initial[i]),
@@ -114,7 +114,7 @@ pub fn report_json(problem: &Problem, result: &IdentResult, prov: &Provenance) -
         "residuals": result.residuals,
         "iterations": result.iterations,
         "warnings": result.warnings,
-        "settings": settings_json(&problem.settings),
+        "settings": settings_json(problem.settings()),
         "tests": tests,
     })
 }

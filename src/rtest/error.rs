@@ -238,7 +238,7 @@ pub enum RtestError {
         detail: String,
     },
     /// The plane cannot be told from the data.
-    #[error("{at}: circle plane is ambiguous ({detail}); give --plane")]
+    #[error("{at}: circle plane is ambiguous ({detail})")]
     AmbiguousPlane {
         /// The source.
         at: Location,

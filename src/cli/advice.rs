@@ -1,0 +1,50 @@
+//! Flag advice that the command line adds to the library's errors: the library speaks of
+//! physics and files and never names a flag; only here are its errors tied to the options of
+//! a command.
+
+use eij::ident::IdentError;
+use eij::map::MapError;
+use eij::predict::PredictError;
+use eij::rtest::RtestError;
+
+/// The error's message with its causes, `a: b: c`, as anyhow prints it.
+fn chain(e: impl std::error::Error + Send + Sync + 'static) -> String {
+    format!("{:#}", anyhow::Error::new(e))
+}
+
+/// `eij evaluate`: an ambiguous plane can be given with `--plane`.
+pub fn evaluate(e: RtestError) -> anyhow::Error {
+    match e {
+        RtestError::AmbiguousPlane { .. } => anyhow::anyhow!("{e}; give --plane"),
+        e => e.into(),
+    }
+}
+
+/// `eij identify` and `eij verify`: where the settings come from, and that nothing is exported
+/// after a failed fit.
+pub fn identify(e: IdentError) -> anyhow::Error {
+    match e {
+        IdentError::NotConverged { .. } => anyhow::anyhow!(
+            "{e} (raise --max-iters, or check the data); nothing exported"
+        ),
+        IdentError::AtBound { .. } => anyhow::anyhow!(
+            "{e}; widen the bounds or check the data; nothing exported"
+        ),
+        IdentError::Conditions {
+            source: PredictError::PositionLength { .. },
+            ..
+        } => anyhow::anyhow!(
+            "{} (the circle centre is position_mm from the folder's rtest.toml, --position-mm or the config)",
+            chain(e)
+        ),
+        e => e.into(),
+    }
+}
+
+/// `eij map`: grid and plane are flags.
+pub fn map(e: MapError) -> anyhow::Error {
+    match e {
+        MapError::Grid { .. } | MapError::Plane { .. } => anyhow::anyhow!("--{e}"),
+        e => e.into(),
+    }
+}

@@ -1,0 +1,82 @@
+//! Errors of the identification, layered over those of the stages below it.
+
+use crate::predict::{PredictError, SimulationFailure};
+
+/// Errors of the identification.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum IdentError {
+    /// A parameter name that does not fit the machine.
+    #[error("parameter '{name}': {message}")]
+    Parameter {
+        /// The name given.
+        name: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A test or setting that cannot be used.
+    #[error("{input}: {message}")]
+    Test {
+        /// Where the test or setting came from.
+        input: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A test whose conditions the model cannot simulate (e.g. a circle centre outside a stroke).
+    #[error("{input}")]
+    Conditions {
+        /// Where the test came from.
+        input: String,
+        /// What is wrong with its conditions.
+        #[source]
+        source: PredictError,
+    },
+    /// A prediction error not tied to one measured test.
+    #[error(transparent)]
+    Predict(#[from] PredictError),
+    /// Reading or evaluating measured data (the message names file and line).
+    #[error(transparent)]
+    Rtest(#[from] crate::rtest::RtestError),
+    /// A settings file that cannot be parsed (the message names file and place).
+    #[error(transparent)]
+    File(#[from] crate::machine::MachineError),
+    /// Nothing to fit.
+    #[error("{0}")]
+    NoData(String),
+    /// The simulation of a test failed for some parameter set.
+    #[error("simulating {test} at {params}")]
+    Simulation {
+        /// The test.
+        test: String,
+        /// The parameter values.
+        params: String,
+        /// What failed.
+        #[source]
+        source: SimulationFailure,
+    },
+    /// The optimiser ran out of iterations.
+    #[error("the optimiser did not converge in {iterations} iterations")]
+    NotConverged {
+        /// Iterations run.
+        iterations: u64,
+    },
+    /// A parameter ended on a bound: the data want a value outside the bounds.
+    #[error(
+        "{name} ended at its bound {value} (allowed [{min}, {max}]): the data want a value outside"
+    )]
+    AtBound {
+        /// Parameter name.
+        name: String,
+        /// The value at the bound.
+        value: f64,
+        /// Lower bound of the factors.
+        min: f64,
+        /// Upper bound of the factors.
+        max: f64,
+    },
+    /// The singular value decomposition of the Jacobian did not converge.
+    #[error("the singular value decomposition of the Jacobian did not converge")]
+    Svd,
+    /// An error of the optimiser itself.
+    #[error("optimiser: {0}")]
+    Optimiser(String),
+}

@@ -1,0 +1,295 @@
+//! The identification problem: measured tests, the parameters fitted to them, weighted
+//! residuals r = (E_sim − E_meas)/σ and their central-difference Jacobian, and the problem as
+//! argmin sees it ([`Reduced`]: residual operator, Jacobian and cost over the free parameters).
+
+use super::parameters::{to_factor, to_theta, Parameter};
+use super::{IdentError, Settings};
+use crate::axes::Eij;
+use crate::machine::Machine;
+use crate::predict::{CircleTest, EijMap, PredictError, Prediction, SolverKind};
+use argmin::core::{CostFunction, Jacobian, Operator};
+use nalgebra::{DMatrix, DVector};
+use std::collections::BTreeMap;
+
+/// One measured circle test: its conditions and measured EIJ with their uncertainty.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TestCase {
+    /// Where it came from (file, or file and table rows).
+    pub source: String,
+    /// The conditions it was measured under, simulated alike.
+    pub circle: CircleTest,
+    /// Measured value and standard uncertainty σ per parameter, µm·s²/m.
+    pub measured: BTreeMap<Eij, (f64, f64)>,
+}
+
+impl TestCase {
+    /// A short label of the conditions (see [`CircleTest::label`]).
+    pub fn label(&self) -> String {
+        self.circle.label()
+    }
+}
+
+/// The identification problem: base machine, parameters, tests.
+#[derive(Debug, Clone)]
+pub struct Problem {
+    machine: Machine,
+    params: Vec<Parameter>,
+    tests: Vec<TestCase>,
+    settings: Settings,
+    /// The tests' conditions prepared for simulation.
+    prediction: Prediction,
+}
+
+impl Problem {
+    /// Checks that the model can run every test and builds the problem.
+    pub fn new(
+        machine: Machine,
+        params: Vec<Parameter>,
+        tests: Vec<TestCase>,
+        settings: Settings,
+    ) -> Result<Problem, IdentError> {
+        if tests.is_empty() {
+            return Err(IdentError::NoData("no measured tests given".into()));
+        }
+        if params.is_empty() {
+            return Err(IdentError::NoData("no parameters to identify".into()));
+        }
+        for t in &tests {
+            let (a, b) = t.circle.plane.axes();
+            for ax in [a, b] {
+                if machine.axis(ax).is_none() {
+                    return Err(IdentError::Test {
+                        input: t.source.clone(),
+                        message: format!(
+                            "plane {} needs axis {ax}, which the model {} does not have",
+                            t.circle.plane, machine.name
+                        ),
+                    });
+                }
+            }
+            if t.measured.is_empty() {
+                return Err(IdentError::Test {
+                    input: t.source.clone(),
+                    message: "no EIJ values".into(),
+                });
+            }
+        }
+        for (i, p) in params.iter().enumerate() {
+            if params[..i].iter().any(|q| q.name == p.name) {
+                return Err(IdentError::Parameter {
+                    name: p.name.clone(),
+                    message: "given twice".into(),
+                });
+            }
+            let v = p.get(&machine);
+            if !(settings.min_factor..=settings.max_factor).contains(&v) {
+                return Err(IdentError::Parameter {
+                    name: p.name.clone(),
+                    message: format!(
+                        "initial value {v} outside the bounds [{}, {}]",
+                        settings.min_factor, settings.max_factor
+                    ),
+                });
+            }
+        }
+        let circles = tests.iter().map(|t| t.circle.clone()).collect();
+        let prediction =
+            Prediction::new(&machine, circles, settings.simulation.clone()).map_err(|e| match e
+                .test_index()
+            {
+                Some(i) => IdentError::Conditions {
+                    input: tests[i].source.clone(),
+                    source: e,
+                },
+                None => IdentError::Predict(e),
+            })?;
+        Ok(Problem {
+            machine,
+            params,
+            tests,
+            settings,
+            prediction,
+        })
+    }
+
+    /// The parameters.
+    pub fn parameters(&self) -> &[Parameter] {
+        &self.params
+    }
+
+    /// The tests.
+    pub fn tests(&self) -> &[TestCase] {
+        &self.tests
+    }
+
+    /// The machine the problem starts from.
+    pub fn machine(&self) -> &Machine {
+        &self.machine
+    }
+
+    /// The settings.
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// θ = 1/p of the starting machine.
+    pub fn initial_theta(&self) -> DVector<f64> {
+        DVector::from_iterator(
+            self.params.len(),
+            self.params.iter().map(|p| to_theta(p.get(&self.machine))),
+        )
+    }
+
+    /// The machine with factors p = 1/θ.
+    pub fn machine_at(&self, theta: &DVector<f64>) -> Machine {
+        let mut m = self.machine.clone();
+        for (p, t) in self.params.iter().zip(theta.iter()) {
+            p.set(&mut m, to_factor(*t));
+        }
+        m
+    }
+
+    /// `name=value, …` of the factors at θ (for messages).
+    fn describe(&self, theta: &DVector<f64>) -> String {
+        self.params
+            .iter()
+            .zip(theta.iter())
+            .map(|(p, t)| format!("{}={:.4}", p.name, to_factor(*t)))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
+    /// Simulated EIJ of every test for every parameter vector, in parallel over all
+    /// (parameter vector, test) pairs; the order of the result does not depend on threads.
+    pub fn simulate_many(&self, thetas: &[DVector<f64>]) -> Result<Vec<Vec<EijMap>>, IdentError> {
+        self.simulate_many_with(thetas, self.settings.simulation.solver)
+    }
+
+    /// As [`Problem::simulate_many`] with an explicit solver.
+    pub fn simulate_many_with(
+        &self,
+        thetas: &[DVector<f64>],
+        solver: SolverKind,
+    ) -> Result<Vec<Vec<EijMap>>, IdentError> {
+        let machines: Vec<Machine> = thetas.iter().map(|t| self.machine_at(t)).collect();
+        self.prediction
+            .simulate_with(&machines, solver)
+            .map_err(|e| match e {
+                PredictError::Simulation {
+                    test,
+                    machine,
+                    source,
+                } => IdentError::Simulation {
+                    test,
+                    params: self.describe(&thetas[machine]),
+                    source,
+                },
+                other => IdentError::Predict(other),
+            })
+    }
+
+    /// Weighted residuals (E_sim − E_meas)/σ in a fixed order: tests, then parameters by name.
+    pub fn residuals_of(&self, sims: &[EijMap]) -> DVector<f64> {
+        let mut r = Vec::new();
+        for (test, sim) in self.tests.iter().zip(sims) {
+            for (p, (value, sigma)) in &test.measured {
+                let s = sigma.max(self.settings.sigma_floor);
+                r.push((sim.get(p).copied().unwrap_or(f64::NAN) - value) / s);
+            }
+        }
+        DVector::from_vec(r)
+    }
+
+    /// Residuals at θ.
+    pub fn residuals_at(&self, theta: &DVector<f64>) -> Result<DVector<f64>, IdentError> {
+        let sims = self.simulate_many(std::slice::from_ref(theta))?;
+        Ok(self.residuals_of(&sims[0]))
+    }
+
+    /// Central-difference Jacobian ∂r/∂θ at θ (all 2n + 1 parameter sets in parallel) and the
+    /// residuals there. Central differences matter: the tests determine some combinations
+    /// thousands of times more weakly than others, and a forward difference's O(h) error would
+    /// swamp those directions.
+    pub fn jacobian_at(
+        &self,
+        theta: &DVector<f64>,
+    ) -> Result<(DMatrix<f64>, DVector<f64>), IdentError> {
+        let h: Vec<f64> = theta
+            .iter()
+            .map(|t| self.settings.fd_step * t.abs())
+            .collect();
+        let mut thetas = vec![theta.clone()];
+        for i in 0..theta.len() {
+            for sign in [1.0, -1.0] {
+                let mut t = theta.clone();
+                t[i] += sign * h[i];
+                thetas.push(t);
+            }
+        }
+        let sims = self.simulate_many(&thetas)?;
+        let r0 = self.residuals_of(&sims[0]);
+        let mut j = DMatrix::zeros(r0.len(), theta.len());
+        for i in 0..theta.len() {
+            let plus = self.residuals_of(&sims[1 + 2 * i]);
+            let minus = self.residuals_of(&sims[2 + 2 * i]);
+            j.set_column(i, &((plus - minus) / (2.0 * h[i])));
+        }
+        Ok((j, r0))
+    }
+}
+
+/// The problem restricted to the identifiable parameters, as argmin sees it.
+pub(crate) struct Reduced<'a> {
+    pub(crate) problem: &'a Problem,
+    /// Indices of the free parameters in the full vector.
+    pub(crate) free: Vec<usize>,
+    /// The full vector (fixed parameters at their start values).
+    pub(crate) base: DVector<f64>,
+}
+
+impl Reduced<'_> {
+    /// The full θ with the free entries taken from `theta`.
+    pub(crate) fn full(&self, theta: &DVector<f64>) -> DVector<f64> {
+        let mut t = self.base.clone();
+        for (k, &i) in self.free.iter().enumerate() {
+            t[i] = theta[k];
+        }
+        t
+    }
+}
+
+impl Operator for Reduced<'_> {
+    type Param = DVector<f64>;
+    type Output = DVector<f64>;
+    fn apply(&self, theta: &DVector<f64>) -> Result<DVector<f64>, argmin::core::Error> {
+        Ok(self.problem.residuals_at(&self.full(theta))?)
+    }
+}
+
+impl Jacobian for Reduced<'_> {
+    type Param = DVector<f64>;
+    type Jacobian = DMatrix<f64>;
+    fn jacobian(&self, theta: &DVector<f64>) -> Result<DMatrix<f64>, argmin::core::Error> {
+        let (j, _) = self.problem.jacobian_at(&self.full(theta))?;
+        Ok(DMatrix::from_fn(j.nrows(), self.free.len(), |r, c| {
+            j[(r, self.free[c])]
+        }))
+    }
+}
+
+impl CostFunction for Reduced<'_> {
+    type Param = DVector<f64>;
+    type Output = f64;
+    fn cost(&self, theta: &DVector<f64>) -> Result<f64, argmin::core::Error> {
+        // Outside the bounds the model is evaluated on the bound and the excess is penalised,
+        // so that the simplex is pushed back instead of drifting over a flat cost.
+        let (lo, hi) = self.problem.settings.theta_bounds();
+        let clamped = theta.map(|t| t.clamp(lo, hi));
+        let excess = (theta - &clamped).norm_squared() / (hi - lo).powi(2);
+        let cost = self
+            .problem
+            .residuals_at(&self.full(&clamped))?
+            .norm_squared();
+        Ok(cost * (1.0 + 1e3 * excess) + 1e3 * excess)
+    }
+}

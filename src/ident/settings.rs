@@ -1,0 +1,133 @@
+//! Every default of an identification in one place: the optimiser's settings ([`Settings`]),
+//! how measured data are read ([`MeasuredOptions`]), and the fixed thresholds of the method.
+//! How the tests are simulated is [`crate::predict::SimSettings`] (inside [`Settings`]).
+
+use crate::predict::SimSettings;
+
+/// Which optimiser.
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum,
+)]
+#[serde(rename_all = "kebab-case")]
+pub enum Method {
+    /// Levenberg–Marquardt on the weighted residuals (default).
+    Lm,
+    /// Nelder–Mead on the weighted sum of squares (robust fallback, slower).
+    NelderMead,
+}
+
+impl Method {
+    /// The iteration limit when none is given: 50 for Levenberg–Marquardt (it converges in
+    /// about ten on the demo), 2000 for Nelder–Mead (many cheap iterations, one cost each).
+    pub const fn default_max_iters(self) -> u64 {
+        match self {
+            Method::Lm => 50,
+            Method::NelderMead => 2000,
+        }
+    }
+}
+
+/// Settings of an identification run; [`Settings::default`] documents the defaults.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Settings {
+    /// How the tests are simulated inside the optimisation ([`SimSettings::default`]: harmonic
+    /// steady state, 4 steady revolutions, 128 samples per revolution; time domain at 1 kHz).
+    pub simulation: SimSettings,
+    /// Lower bound of every factor (0.01).
+    pub min_factor: f64,
+    /// Upper bound of every factor (10).
+    pub max_factor: f64,
+    /// Iteration limit (`None`: [`Method::default_max_iters`], 50 for Levenberg–Marquardt, 2000
+    /// for Nelder–Mead).
+    pub max_iters: Option<u64>,
+    /// Relative cost decrease that counts as converged (1e-10).
+    pub tol_cost: f64,
+    /// Step in θ = 1/p that counts as converged (1e-8).
+    pub tol_step: f64,
+    /// Central-difference step, relative to θ (1e-3).
+    pub fd_step: f64,
+    /// Optimiser (Levenberg–Marquardt).
+    pub method: Method,
+    /// Smallest σ used to weight a measured value, µm·s²/m (1e-3): keeps noise-free data finite.
+    pub sigma_floor: f64,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            simulation: SimSettings::default(),
+            min_factor: 0.01,
+            max_factor: 10.0,
+            max_iters: None,
+            tol_cost: 1e-10,
+            tol_step: 1e-8,
+            fd_step: 1e-3,
+            method: Method::Lm,
+            sigma_floor: 1e-3,
+        }
+    }
+}
+
+impl Settings {
+    /// Bounds of θ = 1/p.
+    pub fn theta_bounds(&self) -> (f64, f64) {
+        (1.0 / self.max_factor, 1.0 / self.min_factor)
+    }
+
+    /// The iteration limit in force: the one given, else the method's default.
+    pub fn max_iters(&self) -> u64 {
+        self.max_iters
+            .unwrap_or_else(|| self.method.default_max_iters())
+    }
+}
+
+/// How to read measured data ([`MeasuredOptions::default`] documents the defaults).
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeasuredOptions {
+    /// Set radius of the circle tests, mm (2, the paper's radius): R-Test series are evaluated
+    /// with it, table tests (tables carry no radius) take it, and the simulated tests run and are
+    /// evaluated with it, so that measurement and model are compared like with like. A folder's
+    /// `rtest.toml` overrides it.
+    pub radius_mm: f64,
+    /// σ for table values without a standard error, µm·s²/m (0.05).
+    pub table_std_err: f64,
+}
+
+impl Default for MeasuredOptions {
+    fn default() -> Self {
+        MeasuredOptions {
+            radius_mm: 2.0,
+            table_std_err: 0.05,
+        }
+    }
+}
+
+/// A parameter whose Jacobian column norm at the start is below this fraction of the largest
+/// is not seen by the tests: it is kept at its start value and reported not identifiable.
+pub const UNIDENTIFIABLE_COLUMN: f64 = 1e-6;
+
+/// Singular values of the weighted Jacobian below this fraction of the largest mark a
+/// parameter combination the tests hardly separate (a warning).
+pub const NEAR_SINGULAR: f64 = 1e-8;
+
+/// A standard error above this fraction of the value marks a weakly determined parameter
+/// (a warning).
+pub const WEAK_REL_STD_ERR: f64 = 0.5;
+
+/// The χ² test fails (a warning) when s² exceeds 1 by more than this many of its standard
+/// deviations √(2/(m − n)).
+pub const CHI2_SIGMAS: f64 = 4.0;
+
+/// Harmonic and time-domain EIJ of the final model must agree within this fraction of the
+/// value …
+pub const CONFIRM_REL: f64 = 0.01;
+
+/// … or within this many µm·s²/m, whichever is larger (else a warning).
+pub const CONFIRM_ABS_UM_S2_PER_M: f64 = 0.01;
+
+/// Nelder–Mead's starting simplex: the start and one vertex per parameter with θ scaled by this.
+pub const NELDER_MEAD_SIMPLEX_SCALE: f64 = 1.3;
+
+/// Nelder–Mead has converged when the simplex costs spread by less than this fraction of the
+/// starting cost (it has no gradient to test).
+pub const NELDER_MEAD_REL_SPREAD: f64 = 1e-7;
