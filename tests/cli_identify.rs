@@ -1,31 +1,10 @@
 //! `eij identify` from the command line: outputs on success, one clear line and no output on
 //! failure.
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use common::{root, Scratch};
 use std::process::{Command, Output};
-
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-struct Scratch(PathBuf);
-
-impl Scratch {
-    fn new(tag: &str) -> Self {
-        let d = std::env::temp_dir().join(format!("eij-cli-ident-{tag}-{}", std::process::id()));
-        std::fs::create_dir_all(&d).unwrap();
-        Scratch(d)
-    }
-    fn path(&self, name: &str) -> PathBuf {
-        self.0.join(name)
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
 
 /// Runs identify on three ZX files with the Z guideway factors, plus `extra` arguments.
 fn identify(s: &Scratch, extra: &[&str]) -> Output {

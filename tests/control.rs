@@ -7,17 +7,10 @@ use eij::sim::setpoint::{Circle, SetPoint};
 use eij::sim::simulate;
 use nalgebra::{Complex, DMatrix, DVector};
 use std::f64::consts::{PI, TAU};
-use std::path::Path;
 
-fn machine_path(name: &str) -> std::path::PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("machines")
-        .join(name)
-}
+mod common;
 
-fn load(name: &str) -> Machine {
-    Machine::from_file(&machine_path(name)).unwrap()
-}
+use common::machine as load;
 
 /// The following error X_set − X per unit set position of `machines/reference/single-axis.toml`
 /// at s = jω, derived by hand in the Laplace domain. The slide's x and the rotor angle Φ
@@ -125,7 +118,7 @@ fn exported_state_space_integrated_by_rk4_reproduces_the_simulator() {
     let json_path = dir.join("demo.json");
     let status = std::process::Command::new(env!("CARGO_BIN_EXE_eij"))
         .args(["export", "--machine"])
-        .arg(machine_path("demo-vmc.toml"))
+        .arg(common::root().join(common::DEMO))
         .arg("--out")
         .arg(&json_path)
         .status()
@@ -207,7 +200,7 @@ fn exported_state_space_integrated_by_rk4_reproduces_the_simulator() {
 
 #[test]
 fn unstable_gains_are_refused_naming_the_axis() {
-    let text = std::fs::read_to_string(machine_path("reference/single-axis.toml"))
+    let text = std::fs::read_to_string(common::root().join("machines/reference/single-axis.toml"))
         .unwrap()
         .replace("kp_nm_s_per_rad = 2.0", "kp_nm_s_per_rad = 2000.0");
     let machine = Machine::from_toml_str(&text, "hot-gains.toml").unwrap();

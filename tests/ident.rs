@@ -4,15 +4,10 @@ use eij::axes::{Direction, Plane};
 use eij::ident::{identify, IdentError, Parameter, Problem, Settings, TestCase};
 use eij::machine::Machine;
 use eij::predict::{simulated_eij, CircleTest};
-use std::path::Path;
 
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
+mod common;
 
-fn demo_text() -> String {
-    std::fs::read_to_string(root().join("machines/demo-vmc.toml")).unwrap()
-}
+use common::{demo_text, root};
 
 fn conditions(planes: &[Plane], accels: &[f64]) -> Vec<TestCase> {
     let mut v = Vec::new();

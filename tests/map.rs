@@ -1,15 +1,12 @@
 //! EIJ maps over the workspace.
 
 use eij::axes::{Axis, Direction, Eij, Plane};
-use eij::machine::Machine;
 use eij::map::{eij_map, read_csv, to_csv, AxisGrid, MapSpec};
 use eij::predict::{simulated_eij, CircleTest, SimSettings};
-use std::path::Path;
 
-fn demo() -> Machine {
-    Machine::from_file(&Path::new(env!("CARGO_MANIFEST_DIR")).join("machines/demo-vmc.toml"))
-        .unwrap()
-}
+mod common;
+
+use common::demo;
 
 fn spec() -> MapSpec {
     MapSpec {

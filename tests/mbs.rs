@@ -2,16 +2,10 @@
 
 use eij::machine::Machine;
 use eij::mbs::{modal, MbsError, Model};
-use std::path::Path;
 
-fn load(name: &str) -> Machine {
-    Machine::from_file(
-        &Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("machines")
-            .join(name),
-    )
-    .unwrap()
-}
+mod common;
+
+use common::machine as load;
 
 fn frequencies(machine: &Machine, pose: &[f64]) -> Vec<f64> {
     let model = Model::assemble(machine, pose).unwrap();

@@ -1,18 +1,18 @@
 //! The SVG figures: parsed as XML, series found by their colours, titles and axis labels
 //! checked, and the magnified path checked numerically against the magnification.
 
-mod rtest_common;
+mod common;
 
+use common::synth::Synth;
+use common::Scratch;
 use eij::axes::{Axis, Plane};
 use eij::control::ClosedLoop;
-use eij::machine::Machine;
 use eij::report::svg::{self, svg_color};
 use eij::report::{identification_svg, move_svg, CircleView, Conditions, MoveData, ReportError};
 use eij::rtest::EvalOptions;
 use eij::sim::output::{to_csv, CsvOptions};
 use eij::sim::setpoint::JerkLimitedMove;
 use eij::sim::simulate;
-use rtest_common::{scratch_dir, Synth};
 use serde_json::json;
 
 /// A polyline: its stroke colour and points (pixels).
@@ -190,11 +190,7 @@ fn out_of_plane_view_holds_the_deviation_and_the_fitted_plane() {
 }
 
 fn demo_move() -> (ClosedLoop, eij::sim::Run) {
-    let machine = Machine::from_file(std::path::Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/machines/demo-vmc.toml"
-    )))
-    .unwrap();
+    let machine = common::demo();
     let pose = machine.reference_pose();
     let cl = ClosedLoop::new(&machine, &pose).unwrap();
     let mv = JerkLimitedMove::new(Axis::Z, 0.01, 0.3, 8.0, 250.0);
@@ -205,7 +201,8 @@ fn demo_move() -> (ClosedLoop, eij::sim::Run) {
 #[test]
 fn move_plot_from_csv_and_from_run_agree_and_show_three_panels() {
     let (cl, run) = demo_move();
-    let dir = scratch_dir("report-move");
+    let scratch = Scratch::new("report-move");
+    let dir = scratch.0.clone();
     let csv = dir.join("move.csv");
     std::fs::write(&csv, to_csv(&cl, &run, &CsvOptions::default())).unwrap();
     let from_csv = MoveData::read_csv(&csv).unwrap();

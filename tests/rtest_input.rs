@@ -1,12 +1,13 @@
 //! Library-level input validation: the in-memory constructor, the reader's error values and
 //! the EIJ table reader/writer.
 
-mod rtest_common;
+mod common;
 
+use common::synth::Synth;
+use common::Scratch;
 use eij::axes::{Axis, Direction, Eij, Plane};
 use eij::rtest::table::{self, EijRow};
 use eij::rtest::{evaluate, CircleSeries, EvalOptions, Line, RtestError};
-use rtest_common::{scratch_dir, Synth};
 
 fn cols(n: usize) -> (Vec<f64>, [Vec<f64>; 3], [Vec<f64>; 3]) {
     let t: Vec<f64> = (0..n).map(|i| i as f64 * 1e-3).collect();
@@ -50,7 +51,8 @@ fn in_memory_series_is_validated_like_a_file() {
 
 #[test]
 fn in_memory_and_file_series_evaluate_alike() {
-    let d = scratch_dir("input-alike");
+    let scratch = Scratch::new("input-alike");
+    let d = scratch.0.clone();
     let syn = Synth::new(Plane::Yz, false, 3.0);
     let p = d.join("yz.csv");
     syn.write_csv(&p);
@@ -105,7 +107,8 @@ fn plane_override_and_motion_checks() {
 
 #[test]
 fn eij_table_round_trips_and_is_strict() {
-    let d = scratch_dir("input-table");
+    let scratch = Scratch::new("input-table");
+    let d = scratch.0.clone();
     let rows = vec![
         EijRow {
             plane: Plane::Zx,
@@ -197,7 +200,8 @@ fn paper_table_is_a_valid_eij_table() {
 /// lines, spaces around cells; line numbers still count every physical line.
 #[test]
 fn byte_order_mark_crlf_and_blank_lines() {
-    let d = scratch_dir("input-bom");
+    let scratch = Scratch::new("input-bom");
+    let d = scratch.0.clone();
     let p = d.join("bom.csv");
     let text = "\u{feff}t_s, x_int_mm,y_int_mm,z_int_mm,x_ext_mm,y_ext_mm,z_ext_mm\r\n\
                 0,2,0,0,2,0,0\r\n\r\n\n0.001,2,0,0,2,0,0\r\n0.0005,2,0,0,2,0,0\r\n";
@@ -223,7 +227,7 @@ fn byte_order_mark_crlf_and_blank_lines() {
 /// reversals, tiny and huge values) evaluate to a result or an error.
 #[test]
 fn random_series_never_panic() {
-    let mut rng = rtest_common::Rng::new(42);
+    let mut rng = common::synth::Rng::new(42);
     let (mut evaluated, mut succeeded) = (0, 0);
     for case in 0..400 {
         let n = 2 + (rng.gauss().abs() * 1500.0) as usize;

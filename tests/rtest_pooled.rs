@@ -1,10 +1,10 @@
 //! Pooled evaluation: static geometric terms G separated from EIJ across accelerations.
 
-mod rtest_common;
+mod common;
 
+use common::synth::Synth;
 use eij::axes::Plane;
 use eij::rtest::{evaluate, evaluate_pooled, CircleSeries, EvalOptions, RtestError};
-use rtest_common::Synth;
 
 /// Static geometry: a radial/elliptic deviation (G_aa, G_bb), a skew (G_ab, G_ba) and a tilt
 /// of the circle plane (G_ka, G_kb), µm per mm of set position.

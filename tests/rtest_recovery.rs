@@ -1,10 +1,10 @@
-//! EIJ recovery from synthetic circle tests with known truth (generator in `rtest_common`).
+//! EIJ recovery from synthetic circle tests with known truth (generator in `tests/common/synth.rs`).
 
-mod rtest_common;
+mod common;
 
+use common::synth::Synth;
 use eij::axes::{Direction, Plane};
 use eij::rtest::{evaluate, EvalOptions};
-use rtest_common::Synth;
 
 const ACCELS: [f64; 3] = [1.0, 4.0, 10.0];
 

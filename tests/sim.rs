@@ -5,12 +5,11 @@ use eij::control::ClosedLoop;
 use eij::machine::Machine;
 use eij::sim::setpoint::{Circle, JerkLimitedMove};
 use eij::sim::{output, simulate};
-use std::path::Path;
+
+mod common;
 
 fn demo() -> (Machine, ClosedLoop) {
-    let m =
-        Machine::from_file(&Path::new(env!("CARGO_MANIFEST_DIR")).join("machines/demo-vmc.toml"))
-            .unwrap();
+    let m = common::demo();
     let cl = ClosedLoop::new(&m, &m.reference_pose()).unwrap();
     (m, cl)
 }

@@ -3,33 +3,10 @@
 //! across thread counts is pinned by `tests/cli_identify.rs`
 //! (`reports_are_identical_across_runs_and_thread_counts`).
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use common::{root, Scratch};
 use std::process::Command;
-
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-struct Scratch(PathBuf);
-
-impl Scratch {
-    fn new(tag: &str) -> Self {
-        let d = std::env::temp_dir().join(format!("eij-determinism-{tag}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).unwrap();
-        Scratch(d)
-    }
-
-    fn s(&self, name: &str) -> String {
-        self.0.join(name).display().to_string()
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
 
 /// Runs `eij args…` with `threads` rayon workers; returns standard output and the bytes of each
 /// of `outputs` (which are removed afterwards, so that every run writes them anew).

@@ -1,44 +1,19 @@
 //! `eij report`, `eij evaluate --plot` and `eij simulate … --plot` end to end: the folder's
 //! files, the offline links, the numbers in the tables, and the refusals on bad input.
 
-mod rtest_common;
+mod common;
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
+use common::synth::Synth;
+use common::{one_line_error, run, Scratch};
 use eij::axes::Plane;
 use eij::report::html::fmt_eij;
 use eij::rtest::{evaluate, CircleSeries, EvalOptions};
-use rtest_common::{scratch_dir, Synth};
-
-struct Run {
-    ok: bool,
-    stderr: String,
-}
-
-fn eij(args: &[&str]) -> Run {
-    let out = Command::new(env!("CARGO_BIN_EXE_eij"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(args)
-        .output()
-        .expect("run eij");
-    Run {
-        ok: out.status.success(),
-        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
-    }
-}
 
 /// Non-zero exit and one `eij: error:` line naming every needle.
 fn assert_error(args: &[&str], needles: &[&str]) {
-    let r = eij(args);
-    assert!(!r.ok, "expected failure for {args:?}");
-    let lines: Vec<&str> = r.stderr.lines().collect();
-    assert_eq!(lines.len(), 1, "stderr: {}", r.stderr);
-    assert!(lines[0].starts_with("eij: error: "), "{}", lines[0]);
-    assert!(!lines[0].contains("panicked"), "{}", lines[0]);
-    for n in needles {
-        assert!(lines[0].contains(n), "'{n}' not in: {}", lines[0]);
-    }
+    one_line_error(&common::eij(args), needles);
 }
 
 fn s(p: &Path) -> &str {
@@ -81,7 +56,7 @@ fn ident_json(dir: &Path) -> PathBuf {
 
 fn move_csv(dir: &Path) -> PathBuf {
     let p = dir.join("move.csv");
-    let r = eij(&[
+    let r = run(&[
         "simulate",
         "move",
         "--machine",
@@ -120,14 +95,15 @@ fn references(html: &str) -> Vec<String> {
 
 #[test]
 fn report_folder_is_offline_complete_and_holds_the_numbers() {
-    let dir = scratch_dir("report-cli");
+    let scratch = Scratch::new("report-cli");
+    let dir = scratch.0.clone();
     let measured = measured_folder(&dir);
     let id = ident_json(&dir);
     let mv = move_csv(&dir);
     let out = dir.join("report");
     std::fs::create_dir_all(&out).unwrap();
     std::fs::write(out.join("mine.txt"), "keep me").unwrap();
-    let r = eij(&[
+    let r = run(&[
         "report",
         "--measured",
         s(&measured),
@@ -227,7 +203,8 @@ fn report_folder_is_offline_complete_and_holds_the_numbers() {
 
 #[test]
 fn bad_input_is_refused_with_one_line_and_nothing_written() {
-    let dir = scratch_dir("report-bad");
+    let scratch = Scratch::new("report-bad");
+    let dir = scratch.0.clone();
     let measured = measured_folder(&dir);
     let out = dir.join("out");
 
@@ -277,11 +254,12 @@ fn bad_input_is_refused_with_one_line_and_nothing_written() {
 
 #[test]
 fn evaluate_plot_writes_one_figure_and_refuses_several_files() {
-    let dir = scratch_dir("report-eval-plot");
+    let scratch = Scratch::new("report-eval-plot");
+    let dir = scratch.0.clone();
     let measured = measured_folder(&dir);
     let csv = measured.join("zx_ccw_3.csv");
     let plot = dir.join("zx.svg");
-    let r = eij(&[
+    let r = run(&[
         "evaluate",
         s(&csv),
         "--radius-mm",
@@ -321,9 +299,10 @@ fn evaluate_plot_writes_one_figure_and_refuses_several_files() {
 
 #[test]
 fn simulate_plot_draws_the_circle_and_the_move() {
-    let dir = scratch_dir("report-sim-plot");
+    let scratch = Scratch::new("report-sim-plot");
+    let dir = scratch.0.clone();
     let (csv, svg) = (dir.join("c.csv"), dir.join("c.svg"));
-    let r = eij(&[
+    let r = run(&[
         "simulate",
         "circle",
         "--machine",
@@ -360,7 +339,7 @@ fn simulate_plot_draws_the_circle_and_the_move() {
     );
 
     let (mcsv, msvg) = (dir.join("m.csv"), dir.join("m.svg"));
-    let r = eij(&[
+    let r = run(&[
         "simulate",
         "move",
         "--machine",

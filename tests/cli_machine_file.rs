@@ -1,33 +1,14 @@
 //! Bad machine files through the binary: one clear line naming file and key, non-zero exit,
 //! no panic, no output file.
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use common::{demo_text, Scratch};
 use std::process::Command;
-
-fn demo_text() -> String {
-    std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("machines/demo-vmc.toml"))
-        .unwrap()
-}
-
-struct Scratch(PathBuf);
-
-impl Scratch {
-    fn new(tag: &str) -> Self {
-        let d = std::env::temp_dir().join(format!("eij-cli-machine-{tag}-{}", std::process::id()));
-        std::fs::create_dir_all(&d).unwrap();
-        Scratch(d)
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
 
 /// Runs `eij <args…> --machine <file with text>`; returns (success, stderr).
 fn run_with_machine(tag: &str, text: &str, args: &[&str]) -> (bool, String, bool) {
-    let dir = Scratch::new(tag);
+    let dir = Scratch::new(&format!("machine-{tag}"));
     let file = dir.0.join("machine.toml");
     std::fs::write(&file, text).unwrap();
     let out_file = dir.0.join("out.json");

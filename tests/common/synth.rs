@@ -1,4 +1,4 @@
-//! Synthetic R-Test circle tests with known EIJ, shared by the `rtest_*` integration tests.
+//! Synthetic R-Test circle tests with known EIJ.
 //!
 //! The generator (independent of the evaluation code):
 //! * set phase ψ(t): a dwell at rest, a raised-cosine ramp-in of the angular speed from 0 to
@@ -14,8 +14,6 @@
 //!   (µm per mm of set position);
 //! * optional reading noise on the internal readings (`int_noise_um`);
 //! * noise: xorshift64* + Box–Muller, deterministic from `seed`.
-#![allow(dead_code)]
-
 use std::collections::BTreeMap;
 use std::f64::consts::PI;
 use std::path::Path;
@@ -247,14 +245,6 @@ impl Rng {
         let (u1, u2) = (self.uniform(), self.uniform());
         (-2.0 * u1.ln()).sqrt() * (2.0 * PI * u2).cos()
     }
-}
-
-/// A fresh scratch folder for one test.
-pub fn scratch_dir(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("eij-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("scratch dir");
-    d
 }
 
 /// CSV text in the documented column order from columns t, int[x,y,z], ext[x,y,z].

@@ -1,46 +1,24 @@
 //! `eij evaluate` end to end: the binary on good and bad files.
 
-mod rtest_common;
+mod common;
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
+use common::synth::{csv_text, Synth};
+use common::{eij, one_line_error, run, Scratch};
 use eij::axes::Plane;
 use eij::rtest::table;
-use rtest_common::{csv_text, scratch_dir, Synth};
-
-struct Run {
-    ok: bool,
-    stdout: String,
-    stderr: String,
-}
-
-fn eij(args: &[&str]) -> Run {
-    let out = Command::new(env!("CARGO_BIN_EXE_eij"))
-        .args(args)
-        .output()
-        .expect("run eij");
-    Run {
-        ok: out.status.success(),
-        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
-        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
-    }
-}
 
 /// Non-zero exit, exactly one line on stderr naming `file` and every one of `needles`, no panic.
 fn assert_error(args: &[&str], file: &Path, needles: &[&str]) {
-    let r = eij(args);
-    assert!(!r.ok, "expected failure for {args:?}");
-    assert!(r.stdout.is_empty(), "stdout: {}", r.stdout);
-    let lines: Vec<&str> = r.stderr.lines().collect();
-    assert_eq!(lines.len(), 1, "stderr: {}", r.stderr);
-    let line = lines[0];
-    assert!(line.starts_with("eij: error: "), "{line}");
-    assert!(!line.contains("panicked"), "{line}");
+    let out = eij(args);
+    assert!(
+        out.stdout.is_empty(),
+        "stdout: {}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    let line = one_line_error(&out, needles);
     assert!(line.contains(&file.display().to_string()), "{line}");
-    for n in needles {
-        assert!(line.contains(n), "'{n}' not in: {line}");
-    }
 }
 
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
@@ -53,7 +31,8 @@ const HEADER: &str = "t_s,x_int_mm,y_int_mm,z_int_mm,x_ext_mm,y_ext_mm,z_ext_mm"
 
 #[test]
 fn malformed_files_name_file_line_and_column() {
-    let d = scratch_dir("cli-malformed");
+    let scratch = Scratch::new("cli-malformed");
+    let d = scratch.0.clone();
     let rows = "0,2,0,0,2.001,0,0\n0.001,1.9,0.6,0,1.9,0.6,0\n0.002,1.8,0.9,0,1.8,0.9,0\n";
     let cases: Vec<(&str, String, Vec<String>)> = vec![
         (
@@ -121,7 +100,8 @@ fn malformed_files_name_file_line_and_column() {
 
 #[test]
 fn implausible_data_is_refused() {
-    let d = scratch_dir("cli-implausible");
+    let scratch = Scratch::new("cli-implausible");
+    let d = scratch.0.clone();
     // Less than one revolution in all.
     let mut s = Synth::new(Plane::Xy, true, 5.0);
     s.steady_revs = 0.3;
@@ -168,7 +148,7 @@ fn implausible_data_is_refused() {
             "beyond the R-Test range ±3 mm",
         ],
     );
-    let r = eij(&["evaluate", p.to_str().unwrap()]);
+    let r = run(&["evaluate", p.to_str().unwrap()]);
     assert!(
         !r.stderr.contains("µm"),
         "no µm hint for a single outlier: {}",
@@ -213,7 +193,8 @@ fn implausible_data_is_refused() {
 
 #[test]
 fn folders_and_missing_files_are_named() {
-    let d = scratch_dir("cli-paths");
+    let scratch = Scratch::new("cli-paths");
+    let d = scratch.0.clone();
     assert_error(
         &["evaluate", d.to_str().unwrap()],
         &d,
@@ -226,12 +207,13 @@ fn folders_and_missing_files_are_named() {
 
 #[test]
 fn json_output_follows_the_contract() {
-    let d = scratch_dir("cli-json");
+    let scratch = Scratch::new("cli-json");
+    let d = scratch.0.clone();
     let syn = Synth::new(Plane::Zx, true, 5.0);
     let p = d.join("zx_ccw_5.csv");
     syn.write_csv(&p);
     let out = d.join("eij.csv");
-    let r = eij(&[
+    let r = run(&[
         "evaluate",
         p.to_str().unwrap(),
         "--json",
@@ -300,7 +282,7 @@ fn json_output_follows_the_contract() {
     }
 
     // The same run again prints the same bytes.
-    let again = eij(&["evaluate", p.to_str().unwrap(), "--json"]);
+    let again = run(&["evaluate", p.to_str().unwrap(), "--json"]);
     assert_eq!(again.stdout, r.stdout);
 
     // Never overwrite an input.
@@ -321,7 +303,8 @@ fn json_output_follows_the_contract() {
 
 #[test]
 fn table_and_pooled_output() {
-    let d = scratch_dir("cli-pooled");
+    let scratch = Scratch::new("cli-pooled");
+    let d = scratch.0.clone();
     let mut files = Vec::new();
     for (accel, ccw) in [(2.0, true), (10.0, false)] {
         let p = d.join(format!("xy_{accel}.csv"));
@@ -330,14 +313,14 @@ fn table_and_pooled_output() {
     }
     let mut args = vec!["evaluate"];
     args.extend(files.iter().map(String::as_str));
-    let r = eij(&args);
+    let r = run(&args);
     assert!(r.ok, "{}", r.stderr);
     for f in &files {
         assert!(r.stdout.contains(f.as_str()));
     }
     assert!(r.stdout.contains("EXY") && r.stdout.contains("rms residual"));
     args.extend(["--pooled", "--json"]);
-    let r = eij(&args);
+    let r = run(&args);
     assert!(r.ok, "{}", r.stderr);
     let v: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
     assert_eq!(v["tests"].as_array().unwrap().len(), 2);

@@ -3,76 +3,10 @@
 //! (and line or key), no panic, and leaves the output folder exactly as it was (no output, no
 //! temporary file). Cases already pinned elsewhere are cited in the catalogue, not repeated here.
 
-use std::collections::BTreeSet;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-const DEMO: &str = "machines/demo-vmc.toml";
-const ZX_CSV: &str = "measurements/demo-vmc/pos-a/zx_ccw_5.csv";
-const HEADER: &str = "t_s,x_int_mm,y_int_mm,z_int_mm,x_ext_mm,y_ext_mm,z_ext_mm";
-
-/// A scratch folder, removed on drop.
-struct Scratch(PathBuf);
-
-impl Scratch {
-    fn new(tag: &str) -> Self {
-        let d = std::env::temp_dir().join(format!("eij-robust-{tag}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).unwrap();
-        Scratch(d)
-    }
-
-    fn path(&self, name: &str) -> PathBuf {
-        self.0.join(name)
-    }
-
-    fn s(&self, name: &str) -> String {
-        self.path(name).display().to_string()
-    }
-
-    fn write(&self, name: &str, text: impl AsRef<[u8]>) -> String {
-        let p = self.path(name);
-        std::fs::create_dir_all(p.parent().unwrap()).unwrap();
-        std::fs::write(&p, text).unwrap();
-        p.display().to_string()
-    }
-
-    /// Every entry below the folder (hidden temporary files included), with its contents.
-    fn snapshot(&self) -> BTreeSet<(PathBuf, Vec<u8>)> {
-        fn walk(dir: &Path, out: &mut BTreeSet<(PathBuf, Vec<u8>)>) {
-            for e in std::fs::read_dir(dir).unwrap() {
-                let p = e.unwrap().path();
-                if p.is_dir() {
-                    out.insert((p.clone(), Vec::new()));
-                    walk(&p, out);
-                } else {
-                    out.insert((p.clone(), std::fs::read(&p).unwrap()));
-                }
-            }
-        }
-        let mut out = BTreeSet::new();
-        walk(&self.0, &mut out);
-        out
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
-fn eij(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_eij"))
-        .current_dir(root())
-        .args(args)
-        .output()
-        .expect("run eij")
-}
+use common::{eij, one_line_error, root, Scratch, DEMO, HEADER, ZX_CSV};
+use std::path::Path;
 
 /// Runs `eij args…` and checks the contract for a refused input: non-zero exit, one stderr line
 /// starting `eij: error: ` holding every needle, no panic, nothing on stdout, the scratch folder
@@ -80,22 +14,13 @@ fn eij(args: &[&str]) -> Output {
 fn refused(s: &Scratch, args: &[&str], needles: &[&str]) -> String {
     let before = s.snapshot();
     let out = eij(args);
-    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert!(!out.status.success(), "{args:?} succeeded: {stderr}");
     assert!(out.stdout.is_empty(), "{args:?}: stdout not empty");
-    let lines: Vec<&str> = stderr.lines().collect();
-    assert_eq!(lines.len(), 1, "{args:?}: stderr not one line:\n{stderr}");
-    let line = lines[0];
-    assert!(line.starts_with("eij: error: "), "{line}");
-    assert!(!line.contains("panicked"), "{line}");
-    for n in needles {
-        assert!(line.contains(n), "'{n}' not in: {line}");
-    }
+    let line = one_line_error(&out, needles);
     assert!(
         s.snapshot() == before,
         "{args:?}: the scratch folder changed (output or temporary file written)"
     );
-    line.to_string()
+    line
 }
 
 fn circle<'a>(out: &'a str, extra: &[&'a str]) -> Vec<&'a str> {

@@ -2,17 +2,14 @@
 
 use eij::axes::{Direction, Plane};
 use eij::control::ClosedLoop;
-use eij::machine::Machine;
 use eij::predict::{simulated_eij, CircleTest, SimSettings, SolverKind};
 use eij::sim::harmonic;
 use eij::sim::setpoint::Circle;
 use eij::sim::simulate;
-use std::path::Path;
 
-fn demo() -> Machine {
-    Machine::from_file(&Path::new(env!("CARGO_MANIFEST_DIR")).join("machines/demo-vmc.toml"))
-        .unwrap()
-}
+mod common;
+
+use common::demo;
 
 #[test]
 fn harmonic_and_time_domain_eij_agree_for_every_plane_direction_and_acceleration() {

@@ -1,0 +1,151 @@
+//! The one harness of the integration tests: paths to the bundled files, scratch folders,
+//! running the `eij` binary and checking the one-line error contract, and synthetic R-Test
+//! series with known EIJ ([`synth`]). Every test file uses it with `mod common;`.
+#![allow(dead_code)]
+
+pub mod mutation;
+pub mod synth;
+
+use eij::machine::Machine;
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// The bundled demo machine (relative to the repository root).
+pub const DEMO: &str = "machines/demo-vmc.toml";
+/// One R-Test file of the bundled demo measurements.
+pub const ZX_CSV: &str = "measurements/demo-vmc/pos-a/zx_ccw_5.csv";
+/// The contract columns of an R-Test series, in the documented order.
+pub const HEADER: &str = "t_s,x_int_mm,y_int_mm,z_int_mm,x_ext_mm,y_ext_mm,z_ext_mm";
+
+/// The repository root.
+pub fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// A machine file below `machines/` (e.g. `demo-vmc.toml`, `reference/single-axis.toml`).
+pub fn machine(name: &str) -> Machine {
+    Machine::from_file(&root().join("machines").join(name)).unwrap()
+}
+
+/// The demo machine.
+pub fn demo() -> Machine {
+    machine("demo-vmc.toml")
+}
+
+/// The demo machine file's text (for variations of it).
+pub fn demo_text() -> String {
+    std::fs::read_to_string(root().join(DEMO)).unwrap()
+}
+
+/// A scratch folder, emptied on creation and removed on drop.
+pub struct Scratch(pub PathBuf);
+
+impl Scratch {
+    /// `eij-<tag>-<process id>` in the temporary folder.
+    pub fn new(tag: &str) -> Self {
+        let d = std::env::temp_dir().join(format!("eij-{tag}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        Scratch(d)
+    }
+
+    /// A path inside the folder.
+    pub fn path(&self, name: &str) -> PathBuf {
+        self.0.join(name)
+    }
+
+    /// A path inside the folder, as text (for command lines).
+    pub fn s(&self, name: &str) -> String {
+        self.path(name).display().to_string()
+    }
+
+    /// Writes a file (parents created) and returns its path as text.
+    pub fn write(&self, name: &str, text: impl AsRef<[u8]>) -> String {
+        let p = self.path(name);
+        std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+        std::fs::write(&p, text).unwrap();
+        p.display().to_string()
+    }
+
+    /// Every entry below the folder (hidden temporary files included), with its contents.
+    pub fn snapshot(&self) -> BTreeSet<(PathBuf, Vec<u8>)> {
+        fn walk(dir: &Path, out: &mut BTreeSet<(PathBuf, Vec<u8>)>) {
+            for e in std::fs::read_dir(dir).unwrap() {
+                let p = e.unwrap().path();
+                if p.is_dir() {
+                    out.insert((p.clone(), Vec::new()));
+                    walk(&p, out);
+                } else {
+                    out.insert((p.clone(), std::fs::read(&p).unwrap()));
+                }
+            }
+        }
+        let mut out = BTreeSet::new();
+        walk(&self.0, &mut out);
+        out
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// Runs `eij args…` in the repository root.
+pub fn eij(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_eij"))
+        .current_dir(root())
+        .args(args)
+        .output()
+        .expect("run eij")
+}
+
+/// Checks a refused command: non-zero exit, exactly one line `eij: error: …` on standard error
+/// holding every needle, no panic. Returns the line.
+pub fn one_line_error(out: &Output, needles: &[&str]) -> String {
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!out.status.success(), "succeeded: {stderr}");
+    let lines: Vec<&str> = stderr.lines().collect();
+    assert_eq!(lines.len(), 1, "stderr not one line:\n{stderr}");
+    let line = lines[0];
+    assert!(line.starts_with("eij: error: "), "{line}");
+    assert!(!line.contains("panicked"), "{line}");
+    for n in needles {
+        assert!(line.contains(n), "'{n}' not in: {line}");
+    }
+    line.to_string()
+}
+
+/// An error's message followed by its causes, `a: b: c` (as the command line prints it).
+pub fn chain(e: &dyn std::error::Error) -> String {
+    let mut text = e.to_string();
+    let mut source = e.source();
+    while let Some(s) = source {
+        text.push_str(": ");
+        text.push_str(&s.to_string());
+        source = s.source();
+    }
+    text
+}
+
+/// What a run of the binary gave, as text.
+pub struct Run {
+    /// Exit status 0.
+    pub ok: bool,
+    /// Standard output.
+    pub stdout: String,
+    /// Standard error.
+    pub stderr: String,
+}
+
+/// Runs `eij args…` in the repository root and returns its outputs as text.
+pub fn run(args: &[&str]) -> Run {
+    let out = eij(args);
+    Run {
+        ok: out.status.success(),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    }
+}
