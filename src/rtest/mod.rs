@@ -22,10 +22,12 @@
 //! # }
 //! ```
 //!
-//! What counts as steady: the local angular speed (phase differences over 1/4 revolution)
-//! within 0.5 % of the plateau speed; of the longest such run only whole revolutions are kept,
-//! centred. With slow ramps this band includes the last ~5 % of each ramp's duration, where the
-//! acceleration is up to 1 % below the plateau's.
+//! What counts as steady: the local angular speed (half a revolution of phase over the time it
+//! takes) within 0.5 % of the plateau speed; of the longest such run only whole revolutions are
+//! kept, centred. The half-revolution window makes elliptic internal paths (axes with a few per
+//! cent different gain or lag), timestamp jitter and gaps harmless. With slow ramps this band
+//! includes the last ~5 % of each ramp's duration, where the acceleration is up to 1 % below
+//! the plateau's.
 
 use std::collections::BTreeMap;
 

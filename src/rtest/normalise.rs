@@ -386,13 +386,18 @@ fn slope(t: &[f64], y: &[f64]) -> f64 {
 
 /// Finds the steady part and keeps only whole revolutions of it.
 ///
-/// The local angular speed is the phase difference over a window of half a revolution
-/// (`±h` samples, h = 1/4 revolution): the phase ripple at 2ω of an elliptic internal path
-/// (axes that lag differently) has exactly that period and cancels. The plateau speed is first taken as the 90th percentile of the speeds above
-/// half the largest one (dwells and slow ramp parts do not count) and refined as the median
-/// over the plateau; the plateau is the longest run within [`STEADY_TOLERANCE`] of
-/// that speed. Of it the largest whole number of revolutions is kept, centred, so that the
-/// ramp-in and ramp-out are trimmed alike. Returns `(first, end, revolutions)`.
+/// The local angular speed at sample k is half a revolution of phase divided by the time the
+/// path takes for it: π / (t(u_k + π/2) − t(u_k − π/2)), with u the unwrapped phase in the
+/// sense of rotation. The window is defined in phase, not in samples, so every ripple of the
+/// speed that repeats every half revolution (an elliptic internal path: axes with different
+/// gains or lags, ±ε at 2ω) cancels exactly, whatever the sampling, its jitter or its gaps.
+/// The times at the window ends come from a straight line t(u) fitted through the samples
+/// within ±1/16 revolution of each end, which averages timestamp jitter. The plateau speed is
+/// first taken as the 90th percentile of the speeds above half the largest one (dwells and
+/// slow ramp parts do not count) and refined as the median over the plateau; the plateau is
+/// the longest run within `tolerance` of that speed. Of it the largest whole number of
+/// revolutions is kept, centred, so that the ramp-in and ramp-out are trimmed alike. Returns
+/// `(first, end, revolutions)`.
 fn steady_revolutions(
     t: &[f64],
     phase: &[f64],
@@ -412,49 +417,44 @@ fn steady_revolutions(
             total.abs() / TAU
         )));
     }
-    let local_speed = |h: usize| -> Vec<f64> {
-        (h..n - h)
-            .map(|k| sign * (phase[k + h] - phase[k - h]) / (t[k + h] - t[k - h]))
-            .collect()
-    };
-    let percentile_90 = |v: &mut [f64]| -> f64 {
-        let q = (v.len() * 9) / 10;
-        *v.select_nth_unstable_by(q, f64::total_cmp).1
-    };
-    // The mean speed over the whole file underestimates the plateau speed (dwells, ramps), so
-    // the first window is too wide; it is narrowed to half a plateau revolution once.
-    let mean_dt = (t[n - 1] - t[0]) / (n - 1) as f64;
-    let mut h = ((n as f64 * TAU / total.abs() / 4.0) as usize).max(1);
-    let (mut speed, mut scratch, mut reference): (Vec<f64>, Vec<f64>, f64);
-    loop {
-        if n < 2 * h + 3 {
-            return Err(too_short(format!("only {n} samples")));
-        }
-        speed = local_speed(h);
-        let top = speed.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        if top.is_nan() || top <= 0.0 {
+    let u: Vec<f64> = phase.iter().map(|p| sign * p).collect();
+    // The smoothing window is about 1/16 of a plateau revolution: guessed from the mean rate
+    // over the whole file, and set from the plateau speed where that guess is more than twice
+    // too wide (long dwells).
+    let mut dt: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+    let mid = dt.len() / 2;
+    let dt_median = *dt.select_nth_unstable_by(mid, f64::total_cmp).1;
+    let smoothing = |samples_per_rev: f64| ((samples_per_rev / 16.0) as usize).clamp(1, 64);
+    let mut m = smoothing(n as f64 * TAU / total.abs());
+    let (speed, reference) = loop {
+        let speed = half_revolution_speed(t, &u, m);
+        let top = speed
+            .iter()
+            .copied()
+            .filter(|w| w.is_finite())
+            .fold(f64::NEG_INFINITY, f64::max);
+        if !(top > 0.0) {
             return Err(too_short("no steady rotation found".into()));
         }
-        scratch = speed.iter().copied().filter(|&w| w >= 0.5 * top).collect();
-        reference = percentile_90(&mut scratch);
-        if reference <= 0.0 {
-            return Err(too_short("no steady rotation found".into()));
+        let mut fast: Vec<f64> = speed.iter().copied().filter(|&w| w >= 0.5 * top).collect();
+        let q = (fast.len() * 9) / 10;
+        let reference = *fast.select_nth_unstable_by(q, f64::total_cmp).1;
+        let m_plateau = smoothing(TAU / (reference * dt_median));
+        if 2 * m_plateau >= m {
+            break (speed, reference);
         }
-        let h_plateau = ((TAU / (reference * mean_dt) / 4.0) as usize).max(1);
-        if 2 * h_plateau >= h {
-            break;
-        }
-        h = h_plateau;
-    }
+        m = m_plateau;
+    };
+    let mut scratch = Vec::new();
     let (mut k0, mut k1) = longest_run(&speed, reference, tolerance);
+    let step = stride(m);
     scratch.clear();
     scratch.extend_from_slice(&speed[k0..=k1]);
-    let run = scratch.as_mut_slice();
-    let mid = run.len() / 2;
-    let (_, median, _) = run.select_nth_unstable_by(mid, f64::total_cmp);
-    (k0, k1) = longest_run(&speed, *median, tolerance);
-    let (k0, k1) = (k0 + h, k1 + h);
-    let span = sign * (phase[k1] - phase[k0]);
+    let mid = scratch.len() / 2;
+    let median = *scratch.select_nth_unstable_by(mid, f64::total_cmp).1;
+    (k0, k1) = longest_run(&speed, median, tolerance);
+    let (k0, k1) = (k0 * step, k1 * step);
+    let span = u[k1] - u[k0];
     let revolutions = (span / TAU + 1e-9).floor();
     if revolutions < 1.0 {
         return Err(too_short(format!(
@@ -464,12 +464,94 @@ fn steady_revolutions(
     }
     let slack = span - revolutions * TAU;
     let first = (k0..=k1)
-        .find(|&k| sign * (phase[k] - phase[k0]) >= 0.5 * slack)
+        .find(|&k| u[k] - u[k0] >= 0.5 * slack)
         .unwrap_or(k0);
     let end = (first + 1..=k1)
-        .find(|&k| sign * (phase[k] - phase[first]) >= revolutions * TAU)
+        .find(|&k| u[k] - u[first] >= revolutions * TAU)
         .unwrap_or(k1 + 1);
     Ok((first, end, revolutions as usize))
+}
+
+/// Samples between two speed evaluations: half the smoothing window, about 1/32 revolution.
+fn stride(m: usize) -> usize {
+    m.div_ceil(2)
+}
+
+/// The local angular speed π / (t(u_k + π/2) − t(u_k − π/2)) of every [`stride`]-th sample k
+/// (NaN where the
+/// half revolution around it leaves the record), the window ends smoothed over ±`m` samples;
+/// see [`steady_revolutions`].
+fn half_revolution_speed(t: &[f64], u: &[f64], m: usize) -> Vec<f64> {
+    let n = u.len();
+    // The running maximum is monotone: the first sample reaching a phase is found by bisection
+    // even where the phase wobbles at rest.
+    let mut reach = Vec::with_capacity(n);
+    let mut top = f64::NEG_INFINITY;
+    for &v in u {
+        top = top.max(v);
+        reach.push(top);
+    }
+    // The first sample at or past `target`, walking from the previous answer (the targets of
+    // successive samples move little).
+    let first_reaching = |j: &mut usize, target: f64| -> Option<usize> {
+        while *j > 0 && reach[*j - 1] >= target {
+            *j -= 1;
+        }
+        while *j < n && reach[*j] < target {
+            *j += 1;
+        }
+        (*j > 0 && *j < n).then_some(*j)
+    };
+    let (mut j_lo, mut j_hi) = (0, 0);
+    (0..n)
+        .step_by(stride(m))
+        .map(|k| {
+            let (lo, hi) = (u[k] - 0.25 * TAU, u[k] + 0.25 * TAU);
+            match (first_reaching(&mut j_lo, lo), first_reaching(&mut j_hi, hi)) {
+                (Some(a), Some(b)) => {
+                    let dt = local_time(t, u, b, hi, m) - local_time(t, u, a, lo, m);
+                    if dt > 0.0 {
+                        PI / dt
+                    } else {
+                        f64::NAN
+                    }
+                }
+                _ => f64::NAN,
+            }
+        })
+        .collect()
+}
+
+/// The time at which the phase reaches `target`, from a straight line t(u) through the samples
+/// `j − m ..= j + m` (j the first sample at or past the target); the straight line between
+/// samples j − 1 and j where the phase barely moves over that window (rest).
+fn local_time(t: &[f64], u: &[f64], j: usize, target: f64, m: usize) -> f64 {
+    let lo = j.saturating_sub(m);
+    let hi = (j + m).min(t.len() - 1);
+    let k = (hi + 1 - lo) as f64;
+    let (mu, mt) = (
+        u[lo..=hi].iter().sum::<f64>() / k,
+        t[lo..=hi].iter().sum::<f64>() / k,
+    );
+    let (mut suu, mut sut) = (0.0, 0.0);
+    for i in lo..=hi {
+        suu += (u[i] - mu) * (u[i] - mu);
+        sut += (u[i] - mu) * (t[i] - mt);
+    }
+    let linear = || {
+        let (u0, u1) = (u[j - 1], u[j]);
+        let f = if u1 > u0 {
+            (target - u0) / (u1 - u0)
+        } else {
+            1.0
+        };
+        t[j - 1] + f * (t[j] - t[j - 1])
+    };
+    if suu > 0.0 && sut > 0.0 {
+        mt + sut / suu * (target - mu)
+    } else {
+        linear()
+    }
 }
 
 /// Longest run of `speed` within `tolerance` (relative) of `reference`, as inclusive indices.
