@@ -1,23 +1,25 @@
-//! `eij evaluate FILE.csv... [--plane xy|yz|zx] [--radius-mm R] [--json] [--csv-out FILE]
-//! [--pooled]`
+//! `eij evaluate PATH... [--plane xy|yz|zx] [--radius-mm R] [--json] [--csv-out FILE]
+//! [--pooled] [--fit-time-offset]`
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use eij::axes::Plane;
-use eij::rtest::{self, table, CircleResult, CircleSeries, EvalOptions, PooledResult};
+use eij::rtest::inputs::expand_tests;
+use eij::rtest::suite::{self, EvaluatedTest, Suite, SuiteOptions};
+use eij::rtest::{self, table, CircleSeries, EvalOptions, PooledResult};
 
 /// Arguments of `eij evaluate`.
 #[derive(Debug, clap::Args)]
 pub struct EvaluateArgs {
-    /// R-Test / circle-test CSV files.
-    #[arg(required = true)]
+    /// R-Test / circle-test CSV files, or folders of them (with their `rtest.toml`).
+    #[arg(required = true, value_name = "PATH")]
     pub files: Vec<PathBuf>,
     /// Circle plane (default: the two axes with the largest internal amplitude).
     #[arg(long)]
     pub plane: Option<Plane>,
-    /// Set radius, mm (default: the mean internal radius; when given, the data must agree
-    /// within 10 %).
+    /// Set radius, mm (default: the folder's `rtest.toml`, else the mean internal radius with
+    /// a warning; the data must agree within 10 %).
     #[arg(long, allow_hyphen_values = true)]
     pub radius_mm: Option<f64>,
     /// Print one JSON object (CONTRACT.md) instead of a table.
@@ -30,10 +32,15 @@ pub struct EvaluateArgs {
     /// at different accelerations of one plane).
     #[arg(long)]
     pub pooled: bool,
-    /// Also write the magnified circle plot (SVG) of the test; takes exactly one file (for
+    /// Also write the magnified circle plot (SVG) of the test; takes exactly one test (for
     /// several, use `eij report`).
     #[arg(long, value_name = "FILE.svg")]
     pub plot: Option<PathBuf>,
+    /// Correct single-file tests by the clock offset (external readings lagging the internal
+    /// ones) fitted jointly over the tests of their folder; two-system recordings are always
+    /// aligned.
+    #[arg(long)]
+    pub fit_time_offset: bool,
 }
 
 /// Runs `eij evaluate`.
@@ -60,55 +67,84 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<()> {
         .map(PathBuf::as_path)
         .collect();
     eij::io::check_outputs(&outputs, &inputs)?;
-    let opts = EvalOptions {
+    let tests = expand_tests(&args.files)?;
+    if args.plot.is_some() && tests.len() != 1 {
+        anyhow::bail!(
+            "--plot: {} tests in {}, a plot shows one test (use `eij report` for several)",
+            tests.len(),
+            args.files[0].display()
+        );
+    }
+    let opts = SuiteOptions {
         plane: args.plane,
         radius_mm: args.radius_mm,
+        fallback_radius_mm: None,
+        fit_time_offset: args.fit_time_offset,
     };
-    let series = args
-        .files
-        .iter()
-        .map(CircleSeries::read_csv)
-        .collect::<Result<Vec<_>, _>>()?;
-    let results = series
-        .iter()
-        .map(|s| rtest::evaluate(s, &opts))
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(super::advice::evaluate)?;
+    let suite = suite::evaluate_tests(&tests, &opts).map_err(super::advice::evaluate)?;
     let pooled = if args.pooled {
-        let refs: Vec<&CircleSeries> = series.iter().collect();
+        let refs: Vec<&CircleSeries> = suite.tests.iter().map(|t| &t.series).collect();
+        let radius_mm = suite
+            .tests
+            .first()
+            .filter(|t| t.radius_source != suite::RadiusSource::InternalMean)
+            .map(|t| t.result.radius_mm);
+        let opts = EvalOptions {
+            plane: args.plane,
+            radius_mm,
+        };
         Some(rtest::evaluate_pooled(&refs, &opts).map_err(super::advice::evaluate)?)
     } else {
         None
     };
-    let plot_svg = match &args.plot {
-        Some(_) => {
-            let cond = eij::report::Conditions::of_file(&args.files[0])?;
-            Some(eij::report::CircleView::new(&series[0], &opts)?.magnified_svg(&cond)?)
+    let plot_svg = match (&args.plot, suite.tests.first()) {
+        (Some(_), Some(t)) => {
+            let cond = eij::report::Conditions {
+                source: t.input.name(),
+                machine: None,
+                position_mm: t.input.position_mm.clone(),
+            };
+            let opts = EvalOptions {
+                plane: Some(t.result.plane),
+                radius_mm: Some(t.result.radius_mm),
+            };
+            Some(eij::report::CircleView::new(&t.series, &opts)?.magnified_svg(&cond)?)
         }
-        None => None,
+        _ => None,
     };
     if let Some(out) = &args.csv_out {
-        let rows: Vec<_> = results.iter().flat_map(table::rows_from_result).collect();
+        let rows: Vec<_> = suite
+            .tests
+            .iter()
+            .flat_map(|t| table::rows_from_result(&t.result))
+            .collect();
         table::write(out, &rows, &inputs)?;
     }
     if let (Some(plot), Some(svg)) = (&args.plot, plot_svg) {
         eij::io::write_atomic(plot, svg.as_bytes(), &inputs)?;
     }
+    for w in suite
+        .tests
+        .iter()
+        .flat_map(|t| t.result.warnings.iter().map(move |w| (t, w)))
+    {
+        eprintln!("eij: warning: {}: {}", w.0.input.name(), w.1);
+    }
+    for w in &suite.warnings {
+        eprintln!("eij: warning: {w}");
+    }
     if args.json {
-        let mut doc = serde_json::Map::new();
-        doc.insert(
-            "tests".into(),
-            results.iter().map(CircleResult::to_json).collect(),
-        );
+        let mut doc = suite.to_json_map();
         if let Some(p) = &pooled {
             doc.insert("pooled".into(), p.to_json());
         }
         println!("{}", serde_json::Value::Object(doc));
     } else {
         let mut text = String::new();
-        for r in &results {
-            render_result(&mut text, r);
+        for t in &suite.tests {
+            render_result(&mut text, t);
         }
+        render_suite(&mut text, &suite);
         if let Some(p) = &pooled {
             render_pooled(&mut text, p);
         }
@@ -117,13 +153,30 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn render_result(out: &mut String, r: &CircleResult) {
-    let _ = writeln!(out, "{}", r.source);
+fn render_result(out: &mut String, t: &EvaluatedTest) {
+    let r = &t.result;
+    let _ = writeln!(out, "{}", t.input.name());
     let _ = writeln!(
         out,
-        "  plane {}  {}  radius {:.4} mm  accel {:.3} m/s²  freq {:.3} Hz  {} revolutions  {} samples",
-        r.plane, r.direction, r.radius_mm, r.accel_m_s2, r.freq_hz, r.revolutions, r.samples_used
+        "  plane {}  {}  radius {:.4} mm ({})  accel {:.3} m/s²  freq {:.3} Hz  {} revolutions  {} samples",
+        r.plane,
+        r.direction,
+        r.radius_mm,
+        t.radius_source.name(),
+        r.accel_m_s2,
+        r.freq_hz,
+        r.revolutions,
+        r.samples_used
     );
+    if let Some(o) = &t.time_offset {
+        let se = o.std_err_ms.map_or(String::new(), |s| format!(" ± {s:.4}"));
+        let _ = writeln!(
+            out,
+            "  clock offset {:.4}{se} ms (internal − external, {})",
+            o.offset_ms,
+            o.source.name()
+        );
+    }
     let _ = writeln!(
         out,
         "  {:<9} {:>12} {:>10}  {:>12} {:>12}   (µm·s²/m)",
@@ -146,8 +199,49 @@ fn render_result(out: &mut String, r: &CircleResult) {
         );
     }
     let _ = writeln!(out, "  rms residual {:.4} µm", r.rms_residual_um);
+    if let Some(iso) = &r.iso230 {
+        for (name, p) in [("internal", &iso.internal), ("external", &iso.external)] {
+            let _ = writeln!(
+                out,
+                "  ISO 230-4 {name:<8} G {:>8.3} µm   F max {:>+8.3} µm   F min {:>+8.3} µm",
+                p.circular_deviation_um, p.radial_deviation_max_um, p.radial_deviation_min_um
+            );
+        }
+    }
     for w in &r.warnings {
         let _ = writeln!(out, "  warning: {w}");
+    }
+}
+
+fn render_suite(out: &mut String, suite: &Suite) {
+    for b in &suite.bidirectional {
+        let _ = writeln!(
+            out,
+            "ISO 230-4 bi-directional circular deviation G(b) of {} and {}: internal {:.3} µm, external {:.3} µm",
+            suite.tests[b.tests[0]].input.name(),
+            suite.tests[b.tests[1]].input.name(),
+            b.internal_um,
+            b.external_um
+        );
+    }
+    for c in &suite.clocks {
+        let se = c.std_err_ms.map_or(String::new(), |s| format!(" ± {s:.4}"));
+        let _ = writeln!(
+            out,
+            "clock {}: offset {:.4}{se} ms over {} test(s){}{}",
+            c.clock,
+            c.offset_ms,
+            c.tests.len(),
+            if c.separable {
+                ""
+            } else {
+                ", not separable from cross-talk"
+            },
+            if c.applied { "" } else { ", not applied" }
+        );
+        for n in &c.notes {
+            let _ = writeln!(out, "  warning: {n}");
+        }
     }
 }
 

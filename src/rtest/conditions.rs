@@ -1,30 +1,117 @@
-//! Test conditions of R-Test files that the series themselves do not carry: the set radius and
-//! the circle-centre position, stated once per folder in `rtest.toml`.
+//! Test conditions of R-Test files that the series themselves do not carry, stated once per
+//! folder in `rtest.toml` (docs/measurement-files.md): the set radius and circle-centre
+//! position, how the files name their columns and in which unit (`[columns]`), and per-test
+//! entries (`[[test]]`) with their own conditions, including tests recorded by two systems
+//! (an `internal` and an `external` file with their own clocks).
 
+use super::layout::{ColumnEntry, ColumnMap};
 use super::RtestError;
+use crate::axes::{Direction, Plane};
 use serde::Deserialize;
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// The file of a folder that states the conditions of the R-Test files in it.
 pub const CONDITIONS_FILE: &str = "rtest.toml";
 
 /// Conditions of the circle tests of one folder (`rtest.toml`); absent keys are unknown.
-#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct TestConditions {
     /// Set radius of the circles, mm (0 < r ≤ 3, the R-Test range).
     pub radius_mm: Option<f64>,
     /// Axis positions of the circle centre, mm, in the machine's axis order.
     pub position_mm: Option<Vec<f64>>,
+    /// How the files name the contract columns and in which unit (`[columns]`).
+    pub columns: ColumnMap,
+    /// `[columns]` with `[internal_columns]` over it: the map of the internal files of tests
+    /// recorded by two systems.
+    pub internal_columns: ColumnMap,
+    /// `[columns]` with `[external_columns]` over it: the map of their external files.
+    pub external_columns: ColumnMap,
+    /// The `[[test]]` entries, in file order.
+    pub tests: Vec<TestEntry>,
+    /// The `rtest.toml` these conditions come from, if any.
+    pub file: Option<PathBuf>,
+}
+
+/// What a test's data are: one file with both measurements, or one file per measuring system.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Recording {
+    /// One file with `t_s`, the internal and the external columns.
+    Single(PathBuf),
+    /// Two systems with their own clocks: the internal file (`t_s` and `_int_mm`, e.g. a CNC
+    /// trace) and the external one (`t_s` and `_ext_mm`, e.g. the R-Test logger).
+    Split {
+        /// The internal (axis readings) file.
+        internal: PathBuf,
+        /// The external (R-Test) file.
+        external: PathBuf,
+    },
+}
+
+/// One `[[test]]` entry: its data and the conditions that override the folder's.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TestEntry {
+    /// 1-based number of the entry in `rtest.toml`.
+    pub number: usize,
+    /// Its data, paths relative to the folder resolved.
+    pub recording: Recording,
+    /// Circle plane, where stated.
+    pub plane: Option<Plane>,
+    /// Sense of rotation, where stated (checked against the data).
+    pub direction: Option<Direction>,
+    /// Set radius, mm.
+    pub radius_mm: Option<f64>,
+    /// Circle-centre position, mm.
+    pub position_mm: Option<Vec<f64>>,
+    /// Programmed feed, mm/min (checked against the data).
+    pub feed_mm_min: Option<f64>,
+    /// Free text carried into the outputs.
+    pub note: Option<String>,
+    /// The clock group of a two-system test: tests of one group share one constant clock
+    /// offset (default: one group per folder).
+    pub clock: Option<String>,
+    /// A known clock offset (internal clock minus external clock), ms: used as given, not
+    /// estimated.
+    pub time_offset_ms: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawConditions {
+    radius_mm: Option<f64>,
+    position_mm: Option<Vec<f64>>,
+    columns: Option<BTreeMap<String, ColumnEntry>>,
+    internal_columns: Option<BTreeMap<String, ColumnEntry>>,
+    external_columns: Option<BTreeMap<String, ColumnEntry>>,
+    #[serde(default)]
+    test: Vec<RawTest>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawTest {
+    file: Option<PathBuf>,
+    internal: Option<PathBuf>,
+    external: Option<PathBuf>,
+    plane: Option<String>,
+    direction: Option<String>,
+    radius_mm: Option<f64>,
+    position_mm: Option<Vec<f64>>,
+    feed_mm_min: Option<f64>,
+    note: Option<String>,
+    clock: Option<String>,
+    time_offset_ms: Option<f64>,
 }
 
 impl TestConditions {
     /// The conditions of `file`: the `rtest.toml` in its folder, or none.
     pub fn of_file(file: &Path) -> Result<TestConditions, RtestError> {
-        let dir = match file.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
+        Self::of_folder(&folder_of(file))
+    }
+
+    /// The conditions of the files in `dir`: its `rtest.toml`, or none.
+    pub fn of_folder(dir: &Path) -> Result<TestConditions, RtestError> {
         let path = dir.join(CONDITIONS_FILE);
         if !path.is_file() {
             return Ok(TestConditions::default());
@@ -34,39 +121,185 @@ impl TestConditions {
             path: name.clone(),
             message: e.to_string(),
         })?;
-        TestConditions::from_toml_str(&text, &name)
+        let mut c = TestConditions::from_toml_str(&text, &name)?;
+        for t in &mut c.tests {
+            t.recording = match &t.recording {
+                Recording::Single(f) => Recording::Single(dir.join(f)),
+                Recording::Split { internal, external } => Recording::Split {
+                    internal: dir.join(internal),
+                    external: dir.join(external),
+                },
+            };
+        }
+        c.file = Some(path);
+        Ok(c)
     }
 
     /// Parses and validates the text of an `rtest.toml`; `name` stands for the file in error
-    /// messages, which name the key or the line and column.
+    /// messages, which name the key or the line and column. Paths of `[[test]]` entries stay
+    /// as written (relative to the folder).
     pub fn from_toml_str(text: &str, name: &str) -> Result<TestConditions, RtestError> {
         let bad = |key: &str, message: String| RtestError::Conditions {
             file: name.to_string(),
             key: key.to_string(),
             message,
         };
-        let c: TestConditions = toml::from_str(text).map_err(|e| {
+        let raw: RawConditions = toml::from_str(text).map_err(|e| {
             let m = crate::machine::MachineError::toml(name, text, &e);
             bad(&m.key, m.message)
         })?;
-        if let Some(r) = c.radius_mm {
-            if !(r.is_finite() && r > 0.0 && r <= 3.0) {
-                return Err(bad("radius_mm", format!("{r} must lie in (0, 3] mm")));
+        check_radius(raw.radius_mm, "radius_mm", &bad)?;
+        check_position(raw.position_mm.as_deref(), "position_mm", &bad)?;
+        let map = |t: &Option<BTreeMap<String, ColumnEntry>>, table: &str| match t {
+            Some(entries) => ColumnMap::from_entries(entries, name, table),
+            None => Ok(ColumnMap::default()),
+        };
+        let columns = map(&raw.columns, "columns")?;
+        let internal_columns =
+            columns.overridden_by(&map(&raw.internal_columns, "internal_columns")?);
+        let external_columns =
+            columns.overridden_by(&map(&raw.external_columns, "external_columns")?);
+        let mut tests = Vec::new();
+        for (i, t) in raw.test.into_iter().enumerate() {
+            tests.push(test_entry(i + 1, t, &bad)?);
+        }
+        Ok(TestConditions {
+            radius_mm: raw.radius_mm,
+            position_mm: raw.position_mm,
+            columns,
+            internal_columns,
+            external_columns,
+            tests,
+            file: None,
+        })
+    }
+}
+
+fn check_radius(
+    r: Option<f64>,
+    key: &str,
+    bad: &dyn Fn(&str, String) -> RtestError,
+) -> Result<(), RtestError> {
+    match r {
+        Some(r) if !(r.is_finite() && r > 0.0 && r <= 3.0) => {
+            Err(bad(key, format!("{r} must lie in (0, 3] mm")))
+        }
+        _ => Ok(()),
+    }
+}
+
+fn check_position(
+    p: Option<&[f64]>,
+    key: &str,
+    bad: &dyn Fn(&str, String) -> RtestError,
+) -> Result<(), RtestError> {
+    match p {
+        Some(p) if p.iter().any(|v| !v.is_finite()) => {
+            Err(bad(key, "values must be finite".into()))
+        }
+        Some([]) => Err(bad(key, "empty; give one position per machine axis".into())),
+        _ => Ok(()),
+    }
+}
+
+fn test_entry(
+    number: usize,
+    t: RawTest,
+    bad: &dyn Fn(&str, String) -> RtestError,
+) -> Result<TestEntry, RtestError> {
+    let key = |k: &str| format!("[[test]] #{number} {k}");
+    let recording = match (t.file, t.internal, t.external) {
+        (Some(f), None, None) => Recording::Single(f),
+        (None, Some(internal), Some(external)) => {
+            if internal == external {
+                return Err(bad(
+                    &key("external"),
+                    "names the same file as internal".into(),
+                ));
             }
+            Recording::Split { internal, external }
         }
-        if c.position_mm
-            .as_ref()
-            .is_some_and(|p| p.iter().any(|v| !v.is_finite()))
-        {
-            return Err(bad("position_mm", "values must be finite".into()));
-        }
-        if c.position_mm.as_ref().is_some_and(Vec::is_empty) {
+        (None, Some(_), None) => {
             return Err(bad(
-                "position_mm",
-                "empty; give one position per machine axis".into(),
+                &key("external"),
+                "missing: internal needs its external file".into(),
+            ))
+        }
+        (None, None, Some(_)) => {
+            return Err(bad(
+                &key("internal"),
+                "missing: external needs its internal file".into(),
+            ))
+        }
+        (None, None, None) => {
+            return Err(bad(
+                &key("file"),
+                "missing: give file, or internal and external".into(),
+            ))
+        }
+        (Some(_), _, _) => {
+            return Err(bad(
+                &key("file"),
+                "give either file or internal and external, not both".into(),
+            ))
+        }
+    };
+    let plane = t
+        .plane
+        .map(|p| p.parse::<Plane>())
+        .transpose()
+        .map_err(|m| bad(&key("plane"), m))?;
+    let direction = t
+        .direction
+        .map(|d| d.parse::<Direction>())
+        .transpose()
+        .map_err(|m| bad(&key("direction"), m))?;
+    check_radius(t.radius_mm, &key("radius_mm"), bad)?;
+    check_position(t.position_mm.as_deref(), &key("position_mm"), bad)?;
+    if let Some(f) = t.feed_mm_min {
+        if !(f.is_finite() && f > 0.0) {
+            return Err(bad(
+                &key("feed_mm_min"),
+                format!("{f} must be a positive feed"),
             ));
         }
-        Ok(c)
+    }
+    if let Some(o) = t.time_offset_ms {
+        if !o.is_finite() {
+            return Err(bad(&key("time_offset_ms"), format!("{o} must be finite")));
+        }
+        if matches!(recording, Recording::Single(_)) {
+            return Err(bad(
+                &key("time_offset_ms"),
+                "applies to tests recorded by two systems (internal and external)".into(),
+            ));
+        }
+    }
+    if t.clock.is_some() && matches!(recording, Recording::Single(_)) {
+        return Err(bad(
+            &key("clock"),
+            "applies to tests recorded by two systems (internal and external)".into(),
+        ));
+    }
+    Ok(TestEntry {
+        number,
+        recording,
+        plane,
+        direction,
+        radius_mm: t.radius_mm,
+        position_mm: t.position_mm,
+        feed_mm_min: t.feed_mm_min,
+        note: t.note,
+        clock: t.clock,
+        time_offset_ms: t.time_offset_ms,
+    })
+}
+
+/// The folder of a file (`.` for a bare file name).
+pub fn folder_of(file: &Path) -> PathBuf {
+    match file.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
     }
 }
 

@@ -102,12 +102,18 @@ pub enum RtestError {
         message: String,
     },
     /// Required columns are missing from the header.
-    #[error("{at}: missing column(s) {}", columns.join(", "))]
+    #[error(
+        "{at}: missing column(s) {}{}",
+        columns.join(", "),
+        header.as_ref().map_or(String::new(), |h| format!(" (header read: {h})"))
+    )]
     MissingColumns {
         /// The header line.
         at: Location,
         /// The missing names.
         columns: Vec<String>,
+        /// The header as read, with the separator recognised, where that helps.
+        header: Option<String>,
     },
     /// A required column appears twice.
     #[error("{at}: duplicate column '{column}'")]

@@ -35,12 +35,18 @@ use serde_json::{json, Map, Value};
 
 use crate::axes::{Axis, Direction, Eij, Plane};
 
+pub mod clock;
+pub mod clock_fit;
 pub mod conditions;
 pub mod error;
 pub mod fit;
+pub mod inputs;
+pub mod iso230;
+pub mod layout;
 pub mod normalise;
 pub mod pooled;
 pub mod series;
+pub mod suite;
 pub mod table;
 
 pub use error::{Line, Location, RtestError};
@@ -101,6 +107,11 @@ pub struct CircleResult {
     pub plane_fit: PlaneFit,
     /// In-talk by the paper's ellipse fit; `None` (with a warning) when a path is no ellipse.
     pub ellipse_fit: Option<fit::EllipseRoute>,
+    /// ISO 230-4 circular and radial deviations of the internal and the external path over the
+    /// steady revolutions (`None` where no circle can be fitted to a path).
+    pub iso230: Option<iso230::CircleFigures>,
+    /// The steady whole revolutions as sample indices of the series.
+    pub steady: std::ops::Range<usize>,
     /// Disagreements between the routes beyond noise (see [`evaluate`]).
     pub warnings: Vec<String>,
 }
@@ -174,6 +185,17 @@ pub fn evaluate(series: &CircleSeries, opts: &EvalOptions) -> Result<CircleResul
             }
         }
     }
+    let iso = {
+        let figures = |u: &[f64], v: &[f64]| iso230::path_figures(u, v, norm.radius_mm);
+        match (figures(&ia, &ib), figures(&ea, &eb)) {
+            (Some(internal), Some(external)) => Some(iso230::CircleFigures {
+                nominal_radius_mm: norm.radius_mm,
+                internal,
+                external,
+            }),
+            _ => None,
+        }
+    };
     let direction = if norm.omega_rad_s > 0.0 {
         Direction::Ccw
     } else {
@@ -198,6 +220,8 @@ pub fn evaluate(series: &CircleSeries, opts: &EvalOptions) -> Result<CircleResul
             std_err: pf_se,
         },
         ellipse_fit: ellipse,
+        iso230: iso,
+        steady: norm.first..norm.end,
         warnings,
     })
 }
@@ -248,6 +272,32 @@ impl CircleResult {
             })
         });
         m.insert("ellipse_fit".into(), ellipse);
+        if let Some(iso) = &self.iso230 {
+            m.insert(
+                "circular_deviation_um".into(),
+                json!({
+                    "internal": iso.internal.circular_deviation_um,
+                    "external": iso.external.circular_deviation_um,
+                }),
+            );
+            let path = |p: &iso230::PathFigures| {
+                json!({
+                    "circular_deviation_um": p.circular_deviation_um,
+                    "radial_deviation_max_um": p.radial_deviation_max_um,
+                    "radial_deviation_min_um": p.radial_deviation_min_um,
+                    "mean_radius_deviation_um": p.mean_radius_deviation_um,
+                    "centre_mm": p.centre_mm,
+                })
+            };
+            m.insert(
+                "iso230_4".into(),
+                json!({
+                    "nominal_radius_mm": iso.nominal_radius_mm,
+                    "internal": path(&iso.internal),
+                    "external": path(&iso.external),
+                }),
+            );
+        }
         m.insert("warnings".into(), json!(self.warnings));
         Value::Object(m)
     }

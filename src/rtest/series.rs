@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use super::error::{quote_cell, Line, Location, RtestError};
+use super::layout::{read_table, ColumnMap, CONTRACT_COLUMNS};
 use crate::axes::Axis;
 
 /// Column names of the internal readings, x, y, z.
@@ -25,6 +26,9 @@ pub struct CircleSeries {
     ext_mm: [Vec<f64>; 3],
     /// File line of every row, when read from a file.
     lines: Option<Vec<u64>>,
+    /// The file's names of the contract columns (order of [`CONTRACT_COLUMNS`]), where any
+    /// differs from the contract's.
+    names: Option<Box<[String; 7]>>,
 }
 
 impl CircleSeries {
@@ -56,6 +60,7 @@ impl CircleSeries {
             int_mm,
             ext_mm,
             lines: None,
+            names: None,
         };
         for i in 0..n {
             let cells = std::iter::once((TIME_COLUMN, series.t_s[i]))
@@ -85,60 +90,87 @@ impl CircleSeries {
         Ok(series)
     }
 
-    /// Reads a circle-test CSV (CONTRACT.md): one header line; required columns `t_s`,
-    /// `{x,y,z}_int_mm`, `{x,y,z}_ext_mm` in any order; other columns ignored.
+    /// Reads a circle-test CSV (CONTRACT.md): required columns `t_s`, `{x,y,z}_int_mm`,
+    /// `{x,y,z}_ext_mm` in any order; other columns ignored. The dialect (separator, decimal
+    /// comma, comment lines, a metadata block before the header) is recognised, see
+    /// [`super::layout`].
     pub fn read_csv(path: impl AsRef<Path>) -> Result<Self, RtestError> {
+        Self::read_csv_with(path, &ColumnMap::default())
+    }
+
+    /// As [`CircleSeries::read_csv`], the columns named and scaled as `map` says (a folder's
+    /// `rtest.toml` `[columns]`).
+    pub fn read_csv_with(path: impl AsRef<Path>, map: &ColumnMap) -> Result<Self, RtestError> {
         let path = path.as_ref();
         let bytes = read_file(path)?;
-        Self::from_csv_bytes(&path.display().to_string(), &bytes)
+        Self::from_csv_bytes_with(&path.display().to_string(), &bytes, map)
     }
 
     /// As [`CircleSeries::read_csv`] on the bytes of a file already read (or generated);
     /// `name` stands for the file in error messages. A leading UTF-8 byte-order mark is dropped.
     pub fn from_csv_bytes(name: &str, bytes: &[u8]) -> Result<Self, RtestError> {
-        let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
-        let name = name.to_string();
-        let mut reader = csv::ReaderBuilder::new()
-            .has_headers(false)
-            .trim(csv::Trim::All)
-            .from_reader(bytes);
-        let mut counter = LineCounter::new(bytes);
-        let mut records = reader.records();
-        let header = match records.next() {
-            None => {
-                return Err(RtestError::Empty {
-                    at: Location::source(&name),
-                    expected: required_columns().join(","),
-                })
-            }
-            Some(r) => r.map_err(|e| csv_error(&name, &mut counter, e))?,
-        };
-        let header_at = Location::file_line(&name, counter.line_of_record(&header));
-        let required = required_columns();
-        // Other columns (set points, accelerations, …) are ignored.
-        let index = column_indices(&header, &required, &header_at, |_| Ok(()))?;
-        require_columns(&index, &required, &header_at)?;
-        let mut cols: [Vec<f64>; 7] = Default::default();
-        let mut lines = Vec::new();
-        for record in records {
-            let record = record.map_err(|e| csv_error(&name, &mut counter, e))?;
-            let line = counter.line_of_record(&record);
-            for (k, col) in cols.iter_mut().enumerate() {
-                let text = record.get(index[k]).unwrap_or("");
-                col.push(parse_number(text, &name, line, required[k])?);
-            }
-            lines.push(line);
-        }
-        let [t_s, xi, yi, zi, xe, ye, ze] = cols;
+        Self::from_csv_bytes_with(name, bytes, &ColumnMap::default())
+    }
+
+    /// As [`CircleSeries::from_csv_bytes`] with a column map.
+    pub fn from_csv_bytes_with(
+        name: &str,
+        bytes: &[u8],
+        map: &ColumnMap,
+    ) -> Result<Self, RtestError> {
+        let table = read_table(name, bytes, &CONTRACT_COLUMNS, map)?;
+        let mut cols = table.columns.into_iter();
+        let mut next = || cols.next().unwrap_or_default();
+        let t_s = next();
+        let int_mm = [next(), next(), next()];
+        let ext_mm = [next(), next(), next()];
         let series = CircleSeries {
-            source: name,
+            source: name.to_string(),
             t_s,
-            int_mm: [xi, yi, zi],
-            ext_mm: [xe, ye, ze],
-            lines: Some(lines),
+            int_mm,
+            ext_mm,
+            lines: Some(table.lines),
+            names: mapped_names(&table.names),
         };
         series.check_rows_and_time()?;
         Ok(series)
+    }
+
+    /// Builds a series from columns already read from files (`lines`: the file line of every
+    /// row, `names`: the files' names of the seven contract columns, where they differ).
+    pub(crate) fn from_parts(
+        source: String,
+        t_s: Vec<f64>,
+        int_mm: [Vec<f64>; 3],
+        ext_mm: [Vec<f64>; 3],
+        lines: Option<Vec<u64>>,
+        names: Option<Box<[String; 7]>>,
+    ) -> Result<Self, RtestError> {
+        let series = CircleSeries {
+            source,
+            t_s,
+            int_mm,
+            ext_mm,
+            lines,
+            names,
+        };
+        series.check_rows_and_time()?;
+        Ok(series)
+    }
+
+    /// The file's name of a contract column with the contract name, e.g. `Time (t_s)`, or
+    /// the contract name where the file uses it.
+    pub fn column_label(&self, contract: &str) -> String {
+        let file_name = self.names.as_ref().and_then(|names| {
+            CONTRACT_COLUMNS
+                .iter()
+                .position(|c| *c == contract)
+                .map(|i| names[i].clone())
+        });
+        match file_name {
+            Some(n) if !n.eq_ignore_ascii_case(contract) => format!("{n} ({contract})"),
+            _ => contract.to_string(),
+        }
     }
 
     fn check_rows_and_time(&self) -> Result<(), RtestError> {
@@ -246,20 +278,19 @@ pub(crate) fn require_columns(
         Err(RtestError::MissingColumns {
             at: at.clone(),
             columns: missing,
+            header: None,
         })
     }
 }
 
-fn required_columns() -> [&'static str; 7] {
-    [
-        TIME_COLUMN,
-        INT_COLUMNS[0],
-        INT_COLUMNS[1],
-        INT_COLUMNS[2],
-        EXT_COLUMNS[0],
-        EXT_COLUMNS[1],
-        EXT_COLUMNS[2],
-    ]
+/// The file's names where any differs from the contract's.
+fn mapped_names(names: &[String]) -> Option<Box<[String; 7]>> {
+    let differ = names
+        .iter()
+        .zip(CONTRACT_COLUMNS)
+        .any(|(n, c)| !n.eq_ignore_ascii_case(c));
+    let names: [String; 7] = names.to_vec().try_into().ok()?;
+    differ.then(|| Box::new(names))
 }
 
 /// Reads a whole file, telling "not found" and "is a folder" apart from other failures.
@@ -298,10 +329,15 @@ pub(crate) struct LineCounter<'a> {
 impl<'a> LineCounter<'a> {
     /// A counter at the start of `bytes` (line 1).
     pub(crate) fn new(bytes: &'a [u8]) -> Self {
+        Self::starting_at(bytes, 1)
+    }
+
+    /// A counter at the start of `bytes`, which begin on line `line` of their file.
+    pub(crate) fn starting_at(bytes: &'a [u8], line: u64) -> Self {
         LineCounter {
             bytes,
             byte: 0,
-            line: 1,
+            line,
         }
     }
 

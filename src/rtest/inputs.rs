@@ -1,0 +1,249 @@
+//! The measured inputs of a command as circle tests: files and folders expanded, each test with
+//! the conditions its folder's `rtest.toml` gives it (folder keys, overridden by its `[[test]]`
+//! entry).
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+
+use super::conditions::{folder_of, Recording, TestConditions, TestEntry};
+use super::layout::ColumnMap;
+use super::series::CircleSeries;
+use super::RtestError;
+use crate::axes::{Direction, Plane};
+
+/// One circle test to read and evaluate, with everything known about its conditions.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TestInput {
+    /// Its data.
+    pub recording: Recording,
+    /// The `rtest.toml` that states its conditions, if any.
+    pub conditions_file: Option<PathBuf>,
+    /// The number of its `[[test]]` entry, if it has one.
+    pub entry: Option<usize>,
+    /// Set radius, mm.
+    pub radius_mm: Option<f64>,
+    /// Circle-centre position, mm.
+    pub position_mm: Option<Vec<f64>>,
+    /// Circle plane, where stated.
+    pub plane: Option<Plane>,
+    /// Sense of rotation, where stated.
+    pub direction: Option<Direction>,
+    /// Programmed feed, mm/min.
+    pub feed_mm_min: Option<f64>,
+    /// Free text.
+    pub note: Option<String>,
+    /// The clock group (two-system tests): the folder, or the folder and the entry's `clock`.
+    pub clock_group: String,
+    /// A known clock offset, ms (internal clock minus external clock).
+    pub time_offset_ms: Option<f64>,
+    /// Column map of a single file.
+    pub columns: ColumnMap,
+    /// Column map of the internal file of a two-system test.
+    pub internal_columns: ColumnMap,
+    /// Column map of its external file.
+    pub external_columns: ColumnMap,
+}
+
+impl TestInput {
+    /// The test's name in outputs: its file, or `internal + external`.
+    pub fn name(&self) -> String {
+        match &self.recording {
+            Recording::Single(f) => f.display().to_string(),
+            Recording::Split { internal, external } => {
+                format!("{} + {}", internal.display(), external.display())
+            }
+        }
+    }
+
+    /// The file that orders and labels the test: its file, or its internal file.
+    pub fn primary_file(&self) -> &Path {
+        match &self.recording {
+            Recording::Single(f) => f,
+            Recording::Split { internal, .. } => internal,
+        }
+    }
+
+    /// Reads a single-file test (column map applied). Two-system tests are read and brought
+    /// onto one time base by [`super::clock`].
+    pub fn read_single(&self) -> Result<CircleSeries, RtestError> {
+        match &self.recording {
+            Recording::Single(f) => CircleSeries::read_csv_with(f, &self.columns),
+            Recording::Split { .. } => Err(RtestError::Io {
+                path: self.name(),
+                message: "a test recorded by two systems is read through rtest::clock".into(),
+            }),
+        }
+    }
+
+    fn new(recording: Recording, cond: &TestConditions, folder: &Path) -> TestInput {
+        TestInput {
+            recording,
+            conditions_file: cond.file.clone(),
+            entry: None,
+            radius_mm: cond.radius_mm,
+            position_mm: cond.position_mm.clone(),
+            plane: None,
+            direction: None,
+            feed_mm_min: None,
+            note: None,
+            clock_group: folder.display().to_string(),
+            time_offset_ms: None,
+            columns: cond.columns.clone(),
+            internal_columns: cond.internal_columns.clone(),
+            external_columns: cond.external_columns.clone(),
+        }
+    }
+
+    fn from_entry(e: &TestEntry, cond: &TestConditions, folder: &Path) -> TestInput {
+        let mut t = TestInput::new(e.recording.clone(), cond, folder);
+        t.entry = Some(e.number);
+        t.radius_mm = e.radius_mm.or(cond.radius_mm);
+        t.position_mm = e.position_mm.clone().or_else(|| cond.position_mm.clone());
+        t.plane = e.plane;
+        t.direction = e.direction;
+        t.feed_mm_min = e.feed_mm_min;
+        t.note = e.note.clone();
+        if let Some(c) = &e.clock {
+            t.clock_group = format!("{} clock {c}", folder.display());
+        }
+        t.time_offset_ms = e.time_offset_ms;
+        t
+    }
+}
+
+/// The files an entry names, with the key that names them.
+fn entry_files(e: &TestEntry) -> Vec<(&'static str, &Path)> {
+    match &e.recording {
+        Recording::Single(f) => vec![("file", f)],
+        Recording::Split { internal, external } => {
+            vec![("internal", internal), ("external", external)]
+        }
+    }
+}
+
+/// Checks that every file of the folder's entries exists.
+fn check_entries(cond: &TestConditions) -> Result<(), RtestError> {
+    let file = cond
+        .file
+        .as_ref()
+        .map_or(String::new(), |f| f.display().to_string());
+    for e in &cond.tests {
+        for (key, path) in entry_files(e) {
+            if !path.is_file() {
+                return Err(RtestError::Conditions {
+                    file: file.clone(),
+                    key: format!("[[test]] #{} {key}", e.number),
+                    message: format!("{}: file not found", path.display()),
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The tests of a folder (its entries and the CSV files no entry names) and, recursively, of
+/// its sub-folders, in path order.
+fn folder_tests(dir: &Path) -> Result<Vec<TestInput>, RtestError> {
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(|e| RtestError::Io {
+            path: dir.display().to_string(),
+            message: format!("cannot read folder: {e}"),
+        })?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .collect();
+    paths.sort();
+    let cond = TestConditions::of_folder(dir)?;
+    check_entries(&cond)?;
+    let named: BTreeSet<PathBuf> = cond
+        .tests
+        .iter()
+        .flat_map(|e| entry_files(e).into_iter().map(|(_, p)| p.to_path_buf()))
+        .collect();
+    let mut items: Vec<(PathBuf, Vec<TestInput>)> = cond
+        .tests
+        .iter()
+        .map(|e| {
+            let t = TestInput::from_entry(e, &cond, dir);
+            (t.primary_file().to_path_buf(), vec![t])
+        })
+        .collect();
+    for p in paths {
+        if p.is_dir() {
+            items.push((p.clone(), folder_tests(&p)?));
+        } else if p.extension().is_some_and(|x| x.eq_ignore_ascii_case("csv"))
+            && !named.contains(&p)
+        {
+            items.push((
+                p.clone(),
+                vec![TestInput::new(Recording::Single(p), &cond, dir)],
+            ));
+        }
+    }
+    items.sort_by(|a, b| a.0.cmp(&b.0));
+    Ok(items.into_iter().flat_map(|(_, t)| t).collect())
+}
+
+/// The test a file given on its own belongs to: its `[[test]]` entry (a two-system test when
+/// the file is its internal or external file), else a single-file test with the folder's
+/// conditions.
+fn file_test(file: &Path) -> Result<TestInput, RtestError> {
+    let dir = folder_of(file);
+    let cond = TestConditions::of_folder(&dir)?;
+    let same = |p: &Path| {
+        p == file
+            || (p.file_name() == file.file_name()
+                && std::fs::canonicalize(p).ok() == std::fs::canonicalize(file).ok())
+    };
+    for e in &cond.tests {
+        if entry_files(e).iter().any(|(_, p)| same(p)) {
+            check_entries(&TestConditions {
+                tests: vec![e.clone()],
+                ..cond.clone()
+            })?;
+            let mut t = TestInput::from_entry(e, &cond, &dir);
+            if let Recording::Single(_) = t.recording {
+                t.recording = Recording::Single(file.to_path_buf());
+            }
+            return Ok(t);
+        }
+    }
+    Ok(TestInput::new(
+        Recording::Single(file.to_path_buf()),
+        &cond,
+        &dir,
+    ))
+}
+
+/// Expands the measured inputs of a command into circle tests: a file is one test (or, named
+/// by a two-system `[[test]]` entry, that test), a folder gives its entries, its `*.csv` files
+/// that no entry names, and those of its sub-folders, in path order. A test named twice (both
+/// files of a two-system test given) is kept once. A missing path, a folder without tests or
+/// an entry naming a missing file is an error.
+pub fn expand_tests(paths: &[PathBuf]) -> Result<Vec<TestInput>, RtestError> {
+    let mut tests: Vec<TestInput> = Vec::new();
+    for p in paths {
+        if p.is_dir() {
+            let inside = folder_tests(p)?;
+            if inside.is_empty() {
+                return Err(RtestError::Io {
+                    path: p.display().to_string(),
+                    message: "folder holds no .csv files".into(),
+                });
+            }
+            tests.extend(inside);
+        } else if p.is_file() {
+            let t = file_test(p)?;
+            let twice = matches!(t.recording, Recording::Split { .. })
+                && tests.iter().any(|o| o.recording == t.recording);
+            if !twice {
+                tests.push(t);
+            }
+        } else {
+            return Err(RtestError::Io {
+                path: p.display().to_string(),
+                message: "file not found".into(),
+            });
+        }
+    }
+    Ok(tests)
+}

@@ -1,0 +1,708 @@
+//! Evaluation of the circle tests of a command (`eij evaluate`, `identify`, `report`): every
+//! test read with its folder's conditions, tests recorded by two systems brought onto one time
+//! base, clock offsets estimated per clock (see [`super::clock`], [`super::clock_fit`]), each
+//! test evaluated at its set radius, and cw/ccw pairs given their ISO 230-4 bi-directional
+//! circular deviation.
+
+use super::clock::{self, Recording as Record};
+use super::clock_fit::{fit_offset, OffsetFit, OffsetTest};
+use super::conditions::Recording;
+use super::error::{Location, RtestError};
+use super::inputs::TestInput;
+use super::normalise::{normalise, Normalised};
+use super::{evaluate, iso230, CircleResult, CircleSeries, EvalOptions};
+use crate::axes::{Direction, Plane};
+
+/// Options of [`evaluate_tests`].
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct SuiteOptions {
+    /// Circle plane of every test (command line); else the test's `[[test]]` plane, else
+    /// inferred from the data.
+    pub plane: Option<Plane>,
+    /// Set radius of every test (command line); else `rtest.toml`.
+    pub radius_mm: Option<f64>,
+    /// Set radius where neither the command line nor `rtest.toml` gives one (e.g. identify's
+    /// configuration); else the mean internal radius, with a warning.
+    pub fallback_radius_mm: Option<f64>,
+    /// Correct single-file tests by the clock offset fitted over the tests of their folder
+    /// (a probe logger that lags the scales); two-system tests are always aligned.
+    pub fit_time_offset: bool,
+}
+
+/// Where a test's set radius came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RadiusSource {
+    /// `--radius-mm`.
+    CommandLine,
+    /// The folder's `rtest.toml` (folder key or `[[test]]` entry).
+    Conditions,
+    /// The caller's fallback (identify's configuration).
+    Fallback,
+    /// Nothing gave it: the mean internal radius (EIJ then per measured, not set, acceleration).
+    InternalMean,
+}
+
+impl RadiusSource {
+    /// The JSON name: `command-line`, `rtest.toml`, `default`, `internal-mean`.
+    pub fn name(self) -> &'static str {
+        match self {
+            RadiusSource::CommandLine => "command-line",
+            RadiusSource::Conditions => "rtest.toml",
+            RadiusSource::Fallback => "default",
+            RadiusSource::InternalMean => "internal-mean",
+        }
+    }
+}
+
+/// How a test's clock offset was found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OffsetSource {
+    /// Given in `rtest.toml` (`time_offset_ms`).
+    Given,
+    /// Trajectory alignment, refined by the joint fit over the tests of its clock.
+    JointFit,
+    /// Trajectory alignment only: the tests cannot separate the offset from cross-talk.
+    Trajectory,
+}
+
+impl OffsetSource {
+    /// The JSON name: `rtest.toml`, `joint-fit`, `trajectory`.
+    pub fn name(self) -> &'static str {
+        match self {
+            OffsetSource::Given => "rtest.toml",
+            OffsetSource::JointFit => "joint-fit",
+            OffsetSource::Trajectory => "trajectory",
+        }
+    }
+}
+
+/// The clock offset a test was evaluated with.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TimeOffset {
+    /// Internal clock minus external clock, ms.
+    pub offset_ms: f64,
+    /// Its standard error, ms, where fitted.
+    pub std_err_ms: Option<f64>,
+    /// How it was found.
+    pub source: OffsetSource,
+    /// The clock group it belongs to.
+    pub clock: String,
+    /// This test's own trajectory alignment, ms (two-system tests).
+    pub alignment_ms: Option<f64>,
+}
+
+/// One evaluated test.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EvaluatedTest {
+    /// The test and its conditions.
+    pub input: TestInput,
+    /// The series evaluated (two-system tests: merged at the offset used).
+    pub series: CircleSeries,
+    /// The evaluation (its warnings include those of the conditions: direction, feed, radius).
+    pub result: CircleResult,
+    /// Where the set radius came from.
+    pub radius_source: RadiusSource,
+    /// The clock offset applied (two-system tests, and single-file tests corrected by it).
+    pub time_offset: Option<TimeOffset>,
+}
+
+/// What was found about one clock (the tests sharing one offset).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ClockReport {
+    /// The group: a folder, or a folder and its `[[test]]` `clock`.
+    pub clock: String,
+    /// Names of its tests.
+    pub tests: Vec<String>,
+    /// Whether its tests are two-system recordings.
+    pub two_systems: bool,
+    /// The offset used, ms (single-file tests: the fitted lag, applied only with
+    /// `fit_time_offset`).
+    pub offset_ms: f64,
+    /// Its standard error, ms, where fitted.
+    pub std_err_ms: Option<f64>,
+    /// Whether the tests separate the offset from antisymmetric cross-talk.
+    pub separable: bool,
+    /// Whether the offset was applied to the tests.
+    pub applied: bool,
+    /// The joint fit's χ² per degree of freedom, where fitted.
+    pub chi2_per_dof: Option<f64>,
+    /// Why (not) separable, and other remarks.
+    pub notes: Vec<String>,
+}
+
+/// A cw/ccw pair with its ISO 230-4 bi-directional circular deviations.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Bidirectional {
+    /// Indices of the cw and the ccw test in [`Suite::tests`].
+    pub tests: [usize; 2],
+    /// G(b) of the internal paths, µm.
+    pub internal_um: f64,
+    /// G(b) of the external paths, µm.
+    pub external_um: f64,
+}
+
+/// The evaluated tests of a command.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Suite {
+    /// The tests, in input order.
+    pub tests: Vec<EvaluatedTest>,
+    /// The clocks whose offsets were estimated.
+    pub clocks: Vec<ClockReport>,
+    /// cw/ccw pairs (same plane, position, radius, acceleration within 5 %).
+    pub bidirectional: Vec<Bidirectional>,
+    /// Warnings about the whole set (clocks).
+    pub warnings: Vec<String>,
+}
+
+/// Accelerations closer than this ratio pair up as cw/ccw.
+const PAIR_ACCEL_RATIO: f64 = 1.05;
+/// Trajectory alignments of one clock that differ by more than this are not one constant
+/// offset, s (the cross-talk bias of an alignment stays well below: (E_ab − E_ba)·ω/2 is
+/// 0.15 ms for 10 µm·s²/m at 30 rad/s).
+const SAME_CLOCK_SPREAD_S: f64 = 2e-3;
+/// An alignment whose next-best (a whole period away) misfit is not this many times worse is
+/// ambiguous (a record without start or stop of the motion).
+const UNIQUE_ALIGNMENT_RATIO: f64 = 3.0;
+
+struct Prepared {
+    opts: EvalOptions,
+    source: RadiusSource,
+    data: Data,
+}
+
+enum Data {
+    Single(CircleSeries),
+    Split { internal: Record, external: Record },
+}
+
+fn eval_options(input: &TestInput, opts: &SuiteOptions) -> (EvalOptions, RadiusSource) {
+    let plane = opts.plane.or(input.plane);
+    let (radius_mm, source) = match (opts.radius_mm, input.radius_mm, opts.fallback_radius_mm) {
+        (Some(r), _, _) => (Some(r), RadiusSource::CommandLine),
+        (None, Some(r), _) => (Some(r), RadiusSource::Conditions),
+        (None, None, Some(r)) => (Some(r), RadiusSource::Fallback),
+        (None, None, None) => (None, RadiusSource::InternalMean),
+    };
+    (EvalOptions { plane, radius_mm }, source)
+}
+
+/// The tests of one E group share plane and position.
+fn group_key(input: &TestInput, norm: &Normalised) -> String {
+    format!(
+        "{} {} at {:?}",
+        input.clock_group, norm.plane, input.position_mm
+    )
+}
+
+/// Reads, aligns and evaluates `inputs` (see the module docs).
+pub fn evaluate_tests(inputs: &[TestInput], opts: &SuiteOptions) -> Result<Suite, RtestError> {
+    let mut prepared = Vec::with_capacity(inputs.len());
+    for input in inputs {
+        let (eval, source) = eval_options(input, opts);
+        let data = match &input.recording {
+            Recording::Single(_) => Data::Single(input.read_single()?),
+            Recording::Split { internal, external } => Data::Split {
+                internal: Record::read_internal(internal, &input.internal_columns)?,
+                external: Record::read_external(external, &input.external_columns)?,
+            },
+        };
+        prepared.push(Prepared {
+            opts: eval,
+            source,
+            data,
+        });
+    }
+    // Clock groups, in order of first appearance; single-file and two-system tests apart.
+    let mut groups: Vec<(String, bool, Vec<usize>)> = Vec::new();
+    for (i, (input, p)) in inputs.iter().zip(&prepared).enumerate() {
+        let split = matches!(p.data, Data::Split { .. });
+        match groups
+            .iter_mut()
+            .find(|g| g.0 == input.clock_group && g.1 == split)
+        {
+            Some(g) => g.2.push(i),
+            None => groups.push((input.clock_group.clone(), split, vec![i])),
+        }
+    }
+    let mut offsets: Vec<Option<TimeOffset>> = vec![None; inputs.len()];
+    let mut clocks = Vec::new();
+    for (clock, split, members) in &groups {
+        let report = if *split {
+            align_clock(clock, members, inputs, &prepared, &mut offsets)?
+        } else {
+            lag_of_clock(clock, members, inputs, &prepared, opts, &mut offsets)?
+        };
+        clocks.extend(report);
+    }
+    let mut tests = Vec::with_capacity(inputs.len());
+    for ((input, p), offset) in inputs.iter().zip(prepared).zip(offsets) {
+        let series = series_at(input, &p.data, offset.as_ref().map(|o| o.offset_ms * 1e-3))?;
+        let mut result = evaluate(&series, &p.opts)?;
+        result
+            .warnings
+            .extend(condition_warnings(input, &result, p.source));
+        tests.push(EvaluatedTest {
+            input: input.clone(),
+            series,
+            result,
+            radius_source: p.source,
+            time_offset: offset,
+        });
+    }
+    let bidirectional = pairs(&tests);
+    let warnings = clocks
+        .iter()
+        .filter(|c| !c.separable || !c.notes.is_empty())
+        .flat_map(|c| {
+            c.notes
+                .iter()
+                .map(move |n| format!("clock {}: {n}", c.clock))
+        })
+        .collect();
+    Ok(Suite {
+        tests,
+        clocks,
+        bidirectional,
+        warnings,
+    })
+}
+
+/// The series of a test at a clock offset (two-system tests: merged; single files: external
+/// shifted, or as read without an offset).
+fn series_at(
+    input: &TestInput,
+    data: &Data,
+    offset_s: Option<f64>,
+) -> Result<CircleSeries, RtestError> {
+    match (data, offset_s) {
+        (Data::Single(s), None) => Ok(s.clone()),
+        (Data::Single(s), Some(o)) => {
+            let (int, ext) = split_series(s)?;
+            clock::merge(input.name(), &int, &ext, o)
+        }
+        (Data::Split { internal, external }, o) => {
+            clock::merge(input.name(), internal, external, o.unwrap_or(0.0))
+        }
+    }
+}
+
+/// A single-file series as its two recordings on the same clock.
+fn split_series(s: &CircleSeries) -> Result<(Record, Record), RtestError> {
+    use crate::axes::Axis;
+    let int = Axis::ALL.map(|a| s.int_mm(a).to_vec());
+    let ext = Axis::ALL.map(|a| s.ext_mm(a).to_vec());
+    Ok((
+        Record::new(s.source().to_string(), s.t_s().to_vec(), int)?,
+        Record::new(s.source().to_string(), s.t_s().to_vec(), ext)?,
+    ))
+}
+
+/// The internal recording alone, as a series, to find its circle and period.
+fn internal_period(input: &TestInput, r: &Record, opts: &EvalOptions) -> Result<f64, RtestError> {
+    let s = CircleSeries::new(r.source.clone(), r.t_s.clone(), r.mm.clone(), r.mm.clone())?;
+    let norm = normalise(&s, opts).map_err(|e| match e {
+        RtestError::TooShort { detail, .. } => RtestError::TooShort {
+            at: Location::source(&input.name()),
+            detail,
+        },
+        e => e,
+    })?;
+    Ok(std::f64::consts::TAU / norm.omega_rad_s.abs())
+}
+
+/// Two-system tests of one clock: aligned one by one on their trajectories, then (one constant
+/// offset) refined by the joint fit where the tests separate it from cross-talk.
+fn align_clock(
+    clock: &str,
+    members: &[usize],
+    inputs: &[TestInput],
+    prepared: &[Prepared],
+    offsets: &mut [Option<TimeOffset>],
+) -> Result<Vec<ClockReport>, RtestError> {
+    let mut aligned = Vec::new();
+    for &i in members {
+        let Data::Split { internal, external } = &prepared[i].data else {
+            continue;
+        };
+        if let Some(o) = inputs[i].time_offset_ms {
+            offsets[i] = Some(TimeOffset {
+                offset_ms: o,
+                std_err_ms: None,
+                source: OffsetSource::Given,
+                clock: clock.to_string(),
+                alignment_ms: None,
+            });
+            continue;
+        }
+        let period = internal_period(&inputs[i], internal, &prepared[i].opts)?;
+        let a = clock::align(internal, external, period)?;
+        if a.next_best_rms_um < UNIQUE_ALIGNMENT_RATIO * a.rms_um {
+            return Err(RtestError::Pooling {
+                at: Location::source(&inputs[i].name()),
+                detail: format!(
+                    "the clock offset is ambiguous by whole revolutions (the records hold no \
+                     start or stop of the motion: misfit {:.2} µm at {:.3} ms, {:.2} µm a \
+                     period away); give time_offset_ms in its [[test]] entry",
+                    a.rms_um,
+                    a.offset_s * 1e3,
+                    a.next_best_rms_um
+                ),
+            });
+        }
+        aligned.push((i, a.offset_s));
+    }
+    if aligned.is_empty() {
+        return Ok(Vec::new());
+    }
+    let mut sorted: Vec<f64> = aligned.iter().map(|a| a.1).collect();
+    sorted.sort_by(f64::total_cmp);
+    let base = sorted[sorted.len() / 2];
+    let spread = sorted[sorted.len() - 1] - sorted[0];
+    let names = |set: &[(usize, f64)]| set.iter().map(|(i, _)| inputs[*i].name()).collect();
+    let mut notes = Vec::new();
+    let one_clock = spread <= SAME_CLOCK_SPREAD_S;
+    let fit = if one_clock {
+        let norms = aligned
+            .iter()
+            .map(|&(i, _)| {
+                let s = series_at(&inputs[i], &prepared[i].data, Some(base))?;
+                normalise(&s, &prepared[i].opts)
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        joint_offset(clock, &aligned, inputs, &norms)?
+    } else {
+        notes.push(format!(
+            "the trajectory alignments of its tests differ by {:.3} ms: not one constant \
+             offset (clocks restarted or drifting), each test keeps its own, which cannot tell \
+             a clock offset from antisymmetric cross-talk",
+            spread * 1e3
+        ));
+        None
+    };
+    let separable = fit.as_ref().is_some_and(|f| f.separable);
+    for &(i, own) in &aligned {
+        let (offset_s, std_err, source) = match (&fit, one_clock) {
+            (Some(f), _) if f.separable => (
+                base + f.offset_s,
+                Some(f.std_err_s * 1e3),
+                OffsetSource::JointFit,
+            ),
+            (_, true) => (base, None, OffsetSource::Trajectory),
+            (_, false) => (own, None, OffsetSource::Trajectory),
+        };
+        offsets[i] = Some(TimeOffset {
+            offset_ms: offset_s * 1e3,
+            std_err_ms: std_err,
+            source,
+            clock: clock.to_string(),
+            alignment_ms: Some(own * 1e3),
+        });
+    }
+    if let Some(f) = &fit {
+        if !f.separable {
+            notes.push(format!(
+                "offset {:.4} ms from the trajectories only: {}; the antisymmetric in-plane \
+                 cross-talk (e.g. EXZ − EZX) of these tests is not measured (an offset error δ \
+                 shifts it by 2·10⁶·δ/ω µm·s²/m)",
+                base * 1e3,
+                f.reason
+            ));
+        }
+    }
+    Ok(vec![ClockReport {
+        clock: clock.to_string(),
+        tests: names(&aligned),
+        two_systems: true,
+        offset_ms: fit
+            .as_ref()
+            .filter(|f| f.separable)
+            .map_or(base, |f| base + f.offset_s)
+            * 1e3,
+        std_err_ms: fit
+            .as_ref()
+            .filter(|f| f.separable)
+            .map(|f| f.std_err_s * 1e3),
+        separable,
+        applied: true,
+        chi2_per_dof: fit
+            .as_ref()
+            .map(|f| f.chi2_per_dof)
+            .filter(|c| c.is_finite()),
+        notes,
+    }])
+}
+
+/// The joint offset fit over normalised tests of one clock.
+fn joint_offset(
+    clock: &str,
+    members: &[(usize, f64)],
+    inputs: &[TestInput],
+    norms: &[Normalised],
+) -> Result<Option<OffsetFit>, RtestError> {
+    let keys: Vec<String> = members
+        .iter()
+        .zip(norms)
+        .map(|((i, _), n)| group_key(&inputs[*i], n))
+        .collect();
+    let tests: Vec<OffsetTest> = norms
+        .iter()
+        .zip(&keys)
+        .map(|(norm, group)| OffsetTest { norm, group })
+        .collect();
+    fit_offset(&tests)
+        .ok_or_else(|| RtestError::Singular {
+            at: Location::source(clock),
+            detail: "the joint clock-offset fit has no unique solution".into(),
+        })
+        .map(Some)
+}
+
+/// Single-file tests of one clock (folder): the lag of the external readings, fitted jointly
+/// where the tests separate it; applied with `fit_time_offset`, else reported where it is
+/// significant. Known offsets (`time_offset_ms`) are applied as given.
+fn lag_of_clock(
+    clock: &str,
+    members: &[usize],
+    inputs: &[TestInput],
+    prepared: &[Prepared],
+    opts: &SuiteOptions,
+    offsets: &mut [Option<TimeOffset>],
+) -> Result<Vec<ClockReport>, RtestError> {
+    let mut free = Vec::new();
+    for &i in members {
+        match inputs[i].time_offset_ms {
+            Some(o) => {
+                offsets[i] = Some(TimeOffset {
+                    offset_ms: o,
+                    std_err_ms: None,
+                    source: OffsetSource::Given,
+                    clock: clock.to_string(),
+                    alignment_ms: None,
+                })
+            }
+            None => free.push((i, 0.0)),
+        }
+    }
+    if free.len() < 2 {
+        return Ok(Vec::new());
+    }
+    let norms = free
+        .iter()
+        .map(|&(i, _)| match &prepared[i].data {
+            Data::Single(s) => normalise(s, &prepared[i].opts),
+            Data::Split { .. } => unreachable!("single-file group"),
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let Some(fit) = joint_offset(clock, &free, inputs, &norms)? else {
+        return Ok(Vec::new());
+    };
+    if !fit.separable {
+        return Ok(Vec::new());
+    }
+    let significant = fit.offset_s.abs() > 3.0 * fit.std_err_s && fit.offset_s.abs() > 1e-6;
+    let mut notes = Vec::new();
+    if opts.fit_time_offset {
+        for &(i, _) in &free {
+            offsets[i] = Some(TimeOffset {
+                offset_ms: fit.offset_s * 1e3,
+                std_err_ms: Some(fit.std_err_s * 1e3),
+                source: OffsetSource::JointFit,
+                clock: clock.to_string(),
+                alignment_ms: None,
+            });
+        }
+    } else if significant {
+        notes.push(format!(
+            "the external readings are {:.4} ± {:.4} ms {} the internal ones ({}); not \
+             corrected (give --fit-time-offset, or time_offset_ms in rtest.toml): the \
+             antisymmetric in-plane cross-talk of these tests carries it",
+            fit.offset_s.abs() * 1e3,
+            fit.std_err_s * 1e3,
+            if fit.offset_s < 0.0 {
+                "late against"
+            } else {
+                "early against"
+            },
+            fit.reason
+        ));
+    }
+    Ok(vec![ClockReport {
+        clock: clock.to_string(),
+        tests: free.iter().map(|(i, _)| inputs[*i].name()).collect(),
+        two_systems: false,
+        offset_ms: fit.offset_s * 1e3,
+        std_err_ms: Some(fit.std_err_s * 1e3),
+        separable: true,
+        applied: opts.fit_time_offset,
+        chi2_per_dof: Some(fit.chi2_per_dof).filter(|c| c.is_finite()),
+        notes,
+    }])
+}
+
+/// Warnings from comparing a test's stated conditions with its data.
+fn condition_warnings(input: &TestInput, r: &CircleResult, source: RadiusSource) -> Vec<String> {
+    let mut w = Vec::new();
+    if source == RadiusSource::InternalMean {
+        w.push(format!(
+            "no set radius given (--radius-mm or rtest.toml radius_mm): EIJ are per the \
+             acceleration of the mean internal radius {:.4} mm, not per set acceleration",
+            r.radius_mm
+        ));
+    }
+    if let Some(d) = input.direction {
+        if d != r.direction {
+            w.push(format!(
+                "rtest.toml says {d}, the data turn {} (CONTRACT.md: ccw is ω > 0 in a = r cos ωt, \
+                 b = r sin ωt of plane {})",
+                r.direction, r.plane
+            ));
+        }
+    }
+    if let Some(feed) = input.feed_mm_min {
+        let measured = r.freq_hz * std::f64::consts::TAU * r.radius_mm * 60.0;
+        if (measured / feed - 1.0).abs() > 0.05 {
+            w.push(format!(
+                "programmed feed {feed} mm/min, the steady circle runs at {measured:.1} mm/min \
+                 (override, or the machine's limits)"
+            ));
+        }
+    }
+    w
+}
+
+/// cw/ccw pairs of equal plane, position, radius and acceleration, and their G(b).
+fn pairs(tests: &[EvaluatedTest]) -> Vec<Bidirectional> {
+    let mut used = vec![false; tests.len()];
+    let mut out = Vec::new();
+    let same = |a: &EvaluatedTest, b: &EvaluatedTest| {
+        let (ra, rb) = (&a.result, &b.result);
+        ra.plane == rb.plane
+            && a.input.position_mm == b.input.position_mm
+            && a.input.clock_group == b.input.clock_group
+            && (ra.radius_mm - rb.radius_mm).abs() <= 1e-9 * ra.radius_mm
+            && ra.accel_m_s2.max(rb.accel_m_s2)
+                <= PAIR_ACCEL_RATIO * ra.accel_m_s2.min(rb.accel_m_s2)
+    };
+    for i in 0..tests.len() {
+        if used[i] || tests[i].result.direction != Direction::Cw {
+            continue;
+        }
+        let partner = (0..tests.len()).find(|&j| {
+            !used[j] && tests[j].result.direction == Direction::Ccw && same(&tests[i], &tests[j])
+        });
+        let Some(j) = partner else { continue };
+        let path = |t: &EvaluatedTest, ext: bool| {
+            let (a, b) = t.result.plane.axes();
+            let cols = |ax| {
+                let v = if ext {
+                    t.series.ext_mm(ax)
+                } else {
+                    t.series.int_mm(ax)
+                };
+                v[t.result.steady.clone()].to_vec()
+            };
+            (cols(a), cols(b))
+        };
+        let g = |ext: bool| {
+            let (p, q) = (path(&tests[i], ext), path(&tests[j], ext));
+            iso230::bidirectional_deviation([(&p.0, &p.1), (&q.0, &q.1)])
+        };
+        if let (Some(internal_um), Some(external_um)) = (g(false), g(true)) {
+            used[i] = true;
+            used[j] = true;
+            out.push(Bidirectional {
+                tests: [i, j],
+                internal_um,
+                external_um,
+            });
+        }
+    }
+    out
+}
+
+/// The clock reports as JSON.
+pub fn clocks_json(clocks: &[ClockReport]) -> serde_json::Value {
+    serde_json::Value::Array(
+        clocks
+            .iter()
+            .map(|c| {
+                serde_json::json!({
+                    "clock": c.clock,
+                    "tests": c.tests,
+                    "two_systems": c.two_systems,
+                    "time_offset_ms": c.offset_ms,
+                    "std_err_ms": c.std_err_ms,
+                    "separable": c.separable,
+                    "applied": c.applied,
+                    "chi2_per_dof": c.chi2_per_dof,
+                    "notes": c.notes,
+                })
+            })
+            .collect(),
+    )
+}
+
+impl EvaluatedTest {
+    /// The test's JSON object: [`CircleResult::to_json`] plus `radius_source`, and where known
+    /// `time_offset_ms` with `time_offset` (`std_err_ms`, `source`, `clock`, `alignment_ms`),
+    /// `position_mm` and `note`.
+    pub fn to_json(&self) -> serde_json::Value {
+        let mut v = self.result.to_json();
+        if let serde_json::Value::Object(m) = &mut v {
+            m.insert("file".into(), self.input.name().into());
+            m.insert("radius_source".into(), self.radius_source.name().into());
+            if let Some(o) = &self.time_offset {
+                m.insert("time_offset_ms".into(), o.offset_ms.into());
+                m.insert(
+                    "time_offset".into(),
+                    serde_json::json!({
+                        "std_err_ms": o.std_err_ms,
+                        "source": o.source.name(),
+                        "clock": o.clock,
+                        "alignment_ms": o.alignment_ms,
+                    }),
+                );
+            }
+            if let Some(p) = &self.input.position_mm {
+                m.insert("position_mm".into(), serde_json::json!(p));
+            }
+            if let Some(n) = &self.input.note {
+                m.insert("note".into(), n.clone().into());
+            }
+        }
+        v
+    }
+}
+
+impl Suite {
+    /// The evaluate JSON document (CONTRACT.md): `tests`, and `bidirectional` (cw/ccw pairs
+    /// with `files`, `plane`, `accel_m_s2`, `bidirectional_circular_deviation_um` internal and
+    /// external), `clocks` and `warnings`.
+    pub fn to_json_map(&self) -> serde_json::Map<String, serde_json::Value> {
+        let mut doc = serde_json::Map::new();
+        doc.insert(
+            "tests".into(),
+            self.tests.iter().map(EvaluatedTest::to_json).collect(),
+        );
+        let pairs: Vec<serde_json::Value> = self
+            .bidirectional
+            .iter()
+            .map(|b| {
+                let (cw, ccw) = (&self.tests[b.tests[0]], &self.tests[b.tests[1]]);
+                serde_json::json!({
+                    "files": [cw.input.name(), ccw.input.name()],
+                    "plane": cw.result.plane.name(),
+                    "accel_m_s2": 0.5 * (cw.result.accel_m_s2 + ccw.result.accel_m_s2),
+                    "bidirectional_circular_deviation_um": {
+                        "internal": b.internal_um,
+                        "external": b.external_um,
+                    },
+                })
+            })
+            .collect();
+        doc.insert("bidirectional".into(), pairs.into());
+        doc.insert("clocks".into(), clocks_json(&self.clocks));
+        doc.insert("warnings".into(), serde_json::json!(self.warnings));
+        doc
+    }
+}
