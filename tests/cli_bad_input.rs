@@ -575,7 +575,7 @@ fn rtest_toml_bad_key_or_value() {
     let cases = [
         (
             "radius_mm = 2.0\npositon_mm = [1.0, 2.0, 3.0]\n",
-            "rtest.toml: line 2, column 1: unknown field `positon_mm`, expected `radius_mm` or `position_mm`",
+            "rtest.toml: line 2, column 1: unknown field `positon_mm`, expected one of `radius_mm`, `position_mm`, `columns`",
         ),
         (
             "radius_mm = \"two\"\n",

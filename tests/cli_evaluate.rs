@@ -198,7 +198,7 @@ fn folders_and_missing_files_are_named() {
     assert_error(
         &["evaluate", d.to_str().unwrap()],
         &d,
-        &["is a folder, not a file"],
+        &["folder holds no .csv files"],
     );
     let p = d.join("nope.csv");
     assert_error(&["evaluate", p.to_str().unwrap()], &p, &["file not found"]);
@@ -221,10 +221,12 @@ fn json_output_follows_the_contract() {
         out.to_str().unwrap(),
     ]);
     assert!(r.ok, "{}", r.stderr);
-    assert!(r.stderr.is_empty());
+    // No set radius anywhere: said on standard error and in the JSON.
+    assert_eq!(r.stderr.lines().count(), 1, "{}", r.stderr);
+    assert!(r.stderr.contains("no set radius given"), "{}", r.stderr);
     let v: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
     let top: Vec<&String> = v.as_object().unwrap().keys().collect();
-    assert_eq!(top, ["tests"]);
+    assert_eq!(top, ["bidirectional", "clocks", "tests", "warnings"]);
     let tests = v["tests"].as_array().unwrap();
     assert_eq!(tests.len(), 1);
     let t = &tests[0];
@@ -269,7 +271,13 @@ fn json_output_follows_the_contract() {
             "{p}: {got} ± {se} vs {truth}"
         );
     }
-    assert!(t["warnings"].as_array().unwrap().is_empty());
+    assert_eq!(t["radius_source"], "internal-mean");
+    let warnings = t["warnings"].as_array().unwrap();
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(warnings[0]
+        .as_str()
+        .unwrap()
+        .contains("no set radius given"));
 
     // The EIJ table written alongside holds the same six values.
     let rows = table::read(&out).unwrap();

@@ -2,14 +2,15 @@
 //! internal and the external time base, fitted jointly over several circle tests.
 //!
 //! Physics: with the external samples δ late against the internal ones, the deviation gains
-//! δ·v. On a steady circle v_a = ä_b/ω and v_b = −ä_a/ω, so in one test δ is indistinguishable
-//! from antisymmetric in-plane cross-talk: the joint fit returns E_ab + δ/ω and E_ba − δ/ω
-//! (δ in s, E in µm·s²/m: a factor 10⁶). The shift flips sign between cw and ccw and scales
+//! δ·v. On a steady circle v_a = (ρ/r)·ä_b/ω and v_b = −(ρ/r)·ä_a/ω (ρ the path's radius, r the
+//! set radius of the set accelerations), so in one test δ is indistinguishable from
+//! antisymmetric in-plane cross-talk: the joint fit returns E_ab + (ρ/r)·δ/ω and
+//! E_ba − (ρ/r)·δ/ω (δ in s, E in µm·s²/m: a factor 10⁶). The shift flips sign between cw and ccw and scales
 //! with 1/ω ∝ 1/√a, while EIJ do not change; static geometry G (µm per mm of set position)
 //! enters as −10³·G/ω², even in ω. Across tests of one plane at one position the per-test
 //! cross-talk is therefore
 //!
-//! Ê_ij(ω) = E_ij − 10³·G_ij/ω² + 10⁶·δ·s_ij/ω,   s_ab = +1, s_ba = −1, else 0,
+//! Ê_ij(ω) = E_ij − 10³·G_ij/ω² + 10⁶·δ·s_ij·(ρ/r)/ω,   s_ab = +1, s_ba = −1, else 0,
 //!
 //! and δ, shared by every test of the clock (all planes and positions), follows by weighted
 //! least squares on the per-test estimates with their covariances. G is fitted for a group
@@ -64,6 +65,9 @@ pub struct OffsetFit {
 struct PerTest {
     plane: Plane,
     omega: f64,
+    /// Mean internal radius over the set radius: the path's speed is ρω, its set acceleration
+    /// rω², so the offset's shift of the per-test cross-talk carries ρ/r.
+    speed_ratio: f64,
     group: usize,
     /// Ê per component (a, b, k) and accelerated axis (a, b).
     e: [[f64; 2]; 3],
@@ -110,6 +114,7 @@ fn per_test(norm: &Normalised, group: usize) -> Option<PerTest> {
     Some(PerTest {
         plane: norm.plane,
         omega: norm.omega_rad_s,
+        speed_ratio: norm.measured_radius_mm / norm.radius_mm,
         group,
         e,
         chol,
@@ -184,7 +189,7 @@ pub fn fit_offset(tests: &[OffsetTest]) -> Option<OffsetFit> {
                     (1, 0) => -1.0,
                     _ => 0.0,
                 };
-                raw[(j, delta_col)] = 1e3 * s / pt.omega;
+                raw[(j, delta_col)] = 1e3 * s * pt.speed_ratio / pt.omega;
             }
             let l = pt.chol[comp];
             let l_inv = l.try_inverse()?;

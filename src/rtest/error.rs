@@ -215,6 +215,16 @@ pub enum RtestError {
         /// The observation behind the guess.
         detail: String,
     },
+    /// Values that cannot be what the column's name says: wrong units of time, a dead probe.
+    #[error("{at}: column {column}: {detail}")]
+    Implausible {
+        /// The source.
+        at: Location,
+        /// The column (the file's name, with the contract name where they differ).
+        column: String,
+        /// What was found, and the likely cause.
+        detail: String,
+    },
     /// External minus internal beyond the R-Test measuring range.
     #[error(
         "{at}: column {}: deviation {deviation_mm:.4} mm from {} is beyond the R-Test range \

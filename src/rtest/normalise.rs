@@ -109,6 +109,7 @@ pub fn normalise(series: &CircleSeries, opts: &EvalOptions) -> Result<Normalised
         }
     }
     check_units(series, plane, &amp_int, &amp_ext, opts.radius_mm)?;
+    check_external(series, plane, &amp_int, &amp_ext)?;
     check_probe_range(series)?;
 
     let (ai, bi) = (series.int_mm(a), series.int_mm(b));
@@ -164,6 +165,7 @@ pub fn normalise(series: &CircleSeries, opts: &EvalOptions) -> Result<Normalised
         None => measured_radius_mm,
     };
     let omega_rad_s = slope(&t[first..end], &phase);
+    check_time_scale(series, radius_mm, omega_rad_s)?;
 
     let r_m = radius_mm * 1e-3;
     let w2 = omega_rad_s * omega_rad_s;
@@ -296,6 +298,97 @@ fn check_units(
                 at: whole(),
                 column,
                 detail: format!("circle radius {r0:.1} is {:.0}× the set radius", r0 / set),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Plausible set accelerations of an R-Test circle, m/s² (outside: wrong units of time).
+const PLAUSIBLE_ACCEL_M_S2: (f64, f64) = (0.01, 1000.0);
+/// Plausible circle frequencies, Hz.
+const PLAUSIBLE_FREQ_HZ: (f64, f64) = (0.01, 500.0);
+
+/// A set acceleration r·ω² or a frequency far outside what circle tests use means the time
+/// column is in other units than read: the error names the column and the unit that would
+/// make the test plausible.
+fn check_time_scale(series: &CircleSeries, radius_mm: f64, omega: f64) -> Result<(), RtestError> {
+    let plausible = |w: f64| {
+        let (accel, freq) = (radius_mm * 1e-3 * w * w, w.abs() / TAU);
+        (PLAUSIBLE_ACCEL_M_S2.0..=PLAUSIBLE_ACCEL_M_S2.1).contains(&accel)
+            && (PLAUSIBLE_FREQ_HZ.0..=PLAUSIBLE_FREQ_HZ.1).contains(&freq)
+    };
+    if plausible(omega) {
+        return Ok(());
+    }
+    let (accel, freq) = (radius_mm * 1e-3 * omega * omega, omega.abs() / TAU);
+    // Times read f× too large (f = 1000: ms read as s) give ω f× too small.
+    let hint = [
+        (1e3, "1000× too large (ms read as s?)"),
+        (1e6, "10⁶× too large (µs read as s?)"),
+        (1e-3, "1000× too small (s read as ms?)"),
+        (1e-6, "10⁶× too small (s read as µs?)"),
+    ]
+    .into_iter()
+    .find(|(f, _)| plausible(omega * f))
+    .map_or(String::new(), |(f, what)| {
+        let w = omega * f;
+        format!(
+            "; the times look {what}: then {:.3} m/s² at {:.3} Hz. State the unit in rtest.toml              [columns], e.g. t_s = {{ unit = \"ms\" }}",
+            radius_mm * 1e-3 * w * w,
+            w.abs() / TAU
+        )
+    });
+    Err(RtestError::Implausible {
+        at: Location::source(series.source()),
+        column: series.column_label("t_s"),
+        detail: format!(
+            "set acceleration {accel:.3e} m/s² at {freq:.4} Hz is implausible for a circle test \
+             (expected {}–{} m/s², {}–{} Hz){hint}",
+            PLAUSIBLE_ACCEL_M_S2.0,
+            PLAUSIBLE_ACCEL_M_S2.1,
+            PLAUSIBLE_FREQ_HZ.0,
+            PLAUSIBLE_FREQ_HZ.1
+        ),
+    })
+}
+
+/// The external readings must follow the circle: an in-plane external column that moves less
+/// than half as much as its internal one, or (in a file) an external column that is constant
+/// over the whole file, is a dead or unconnected probe channel, not a deviation.
+fn check_external(
+    series: &CircleSeries,
+    plane: Plane,
+    amp_int: &[f64; 3],
+    amp_ext: &[f64; 3],
+) -> Result<(), RtestError> {
+    let (a, b) = plane.axes();
+    for ax in [a, b] {
+        let (i, e) = (amp_int[ax.index()], amp_ext[ax.index()]);
+        if e < 0.5 * i {
+            return Err(RtestError::Implausible {
+                at: Location::source(series.source()),
+                column: series.column_label(EXT_COLUMNS[ax.index()]),
+                detail: format!(
+                    "moves ±{e:.4} mm while {} moves ±{i:.4} mm: the R-Test does not follow the \
+                     circle (dead or unconnected probe channel?)",
+                    series.column_label(INT_COLUMNS[ax.index()])
+                ),
+            });
+        }
+    }
+    // Noise-free series built in memory (simulations, synthetic tests) may hold an exactly
+    // constant normal component; a file from a real probe never does.
+    for ax in Axis::ALL.into_iter().filter(|_| series.is_from_file()) {
+        if amp_ext[ax.index()] == 0.0 {
+            return Err(RtestError::Implausible {
+                at: Location::source(series.source()),
+                column: series.column_label(EXT_COLUMNS[ax.index()]),
+                detail: format!(
+                    "constant ({}) over the whole file: a real probe reading is never constant \
+                     (dead or unconnected probe channel?)",
+                    series.ext_mm(ax)[0]
+                ),
             });
         }
     }

@@ -223,6 +223,11 @@ impl CircleSeries {
         &self.ext_mm[axis.index()]
     }
 
+    /// Whether the series was read from a file (else built in memory).
+    pub fn is_from_file(&self) -> bool {
+        self.lines.is_some()
+    }
+
     /// Where sample `i` (0-based) came from: a file line or an in-memory row.
     pub fn at_row(&self, i: usize) -> Location {
         let line = match &self.lines {
