@@ -35,6 +35,7 @@ use serde_json::{json, Map, Value};
 
 use crate::axes::{Axis, Direction, Eij, Plane};
 
+pub mod checks;
 pub mod clock;
 pub mod clock_fit;
 pub mod conditions;
