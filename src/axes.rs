@@ -245,6 +245,27 @@ impl FromStr for Eij {
     }
 }
 
+/// Serde as the names of files and JSON keys (`x`, `zx`, `ccw`, `EXZ`), through `Display` and
+/// `FromStr`, so that a file is read back with the very names it was written with.
+macro_rules! serde_by_name {
+    ($($t:ty),*) => {$(
+        impl serde::Serialize for $t {
+            fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+                s.collect_str(self)
+            }
+        }
+
+        impl<'de> serde::Deserialize<'de> for $t {
+            fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+                let text = <std::borrow::Cow<'de, str>>::deserialize(d)?;
+                text.parse().map_err(serde::de::Error::custom)
+            }
+        }
+    )*};
+}
+
+serde_by_name!(Axis, Plane, Direction, Eij);
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -289,6 +289,12 @@ impl Prediction {
         &self.settings
     }
 
+    /// The circle centre test `index` is simulated at: its own, else the settings', else the
+    /// machine's reference position (m, machine axis order).
+    pub fn position_m(&self, index: usize) -> &[f64] {
+        &self.poses[self.test_pose[index]]
+    }
+
     /// Simulated EIJ of every test on every machine (`result[machine][test]`), with the
     /// settings' solver.
     pub fn simulate(&self, machines: &[Machine]) -> Result<Vec<Vec<EijMap>>, PredictError> {

@@ -325,14 +325,13 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
     let prep = prepare(&args.machine, &args.measured, &config, &args.params)?;
     let (result, seconds) = run_identification(&prep, args.quiet)?;
     let toml_text = report::machine_toml(&prep.problem, &result, &prep.provenance)
-        .map_err(|e| anyhow::anyhow!("cannot write the identified machine: {e}"))?;
-    let report_value = report::report_json(&prep.problem, &result, &prep.provenance);
+        .context("cannot write the identified machine")?;
+    let ident_report = report::IdentReport::new(&prep.problem, &result, &prep.provenance);
     let svg = match &args.plot {
-        Some(_) => Some(eij::report::identification_svg(&report_value)?),
+        Some(_) => Some(eij::report::identification_svg(&ident_report)?),
         None => None,
     };
-    let mut json = serde_json::to_vec_pretty(&report_value)?;
-    json.push(b'\n');
+    let json = ident_report.to_json();
     write_output(&args.out, toml_text.as_bytes(), &input_refs)?;
     write_output(&args.report, &json, &input_refs)?;
     if let (Some(path), Some(svg)) = (&args.plot, &svg) {

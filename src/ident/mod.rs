@@ -83,6 +83,8 @@ pub struct Identified {
     pub std_err: Option<f64>,
     /// Whether the tests determine it.
     pub identifiable: bool,
+    /// Whether it ended on a bound of the factors (the data want a value outside).
+    pub at_bound: bool,
 }
 
 /// The result of an identification.
@@ -106,6 +108,8 @@ pub struct IdentResult {
     pub residuals: usize,
     /// Iterations.
     pub iterations: u64,
+    /// Parameter sets simulated (start, Jacobians, line searches, confirmation).
+    pub evaluations: u64,
     /// Simulated EIJ per test at the start.
     pub simulated_initial: Vec<EijMap>,
     /// Simulated EIJ per test at the solution.
@@ -272,6 +276,7 @@ pub fn identify(
     progress: Option<Arc<ProgressFn>>,
 ) -> Result<IdentResult, IdentError> {
     let s = problem.settings();
+    let evaluations_before = problem.evaluations();
     let theta0 = problem.initial_theta();
     let (j0, r0) = problem.jacobian_at(&theta0)?;
     let m = r0.len();
@@ -305,9 +310,9 @@ pub fn identify(
         return Err(IdentError::NotConverged { iterations });
     }
     let (lo, hi) = s.theta_bounds();
+    let at_bound = |i: usize| (theta[i] - lo).abs() < 1e-9 || (theta[i] - hi).abs() < 1e-9;
     for &i in &free {
-        let at = |b: f64| (theta[i] - b).abs() < 1e-9;
-        if at(lo) || at(hi) {
+        if at_bound(i) {
             return Err(IdentError::AtBound {
                 name: problem.parameters()[i].name.clone(),
                 value: to_factor(theta[i]),
@@ -346,6 +351,7 @@ pub fn identify(
                 value: to_factor(theta[i]),
                 std_err: fi.map(|k| u.std_err[k]),
                 identifiable: fi.is_some(),
+                at_bound: fi.is_some() && at_bound(i),
             }
         })
         .collect();
@@ -370,6 +376,7 @@ pub fn identify(
         residual_std: u.residual_std,
         residuals: m,
         iterations,
+        evaluations: problem.evaluations() - evaluations_before,
         simulated_initial,
         simulated_final,
         simulated_final_time,

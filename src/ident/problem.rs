@@ -10,6 +10,7 @@ use crate::predict::{CircleTest, EijMap, PredictError, Prediction, SolverKind};
 use argmin::core::{CostFunction, Jacobian, Operator};
 use nalgebra::{DMatrix, DVector};
 use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// One measured circle test: its conditions and measured EIJ with their uncertainty.
 #[derive(Debug, Clone, PartialEq)]
@@ -30,7 +31,7 @@ impl TestCase {
 }
 
 /// The identification problem: base machine, parameters, tests.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct Problem {
     machine: Machine,
     params: Vec<Parameter>,
@@ -38,6 +39,21 @@ pub struct Problem {
     settings: Settings,
     /// The tests' conditions prepared for simulation.
     prediction: Prediction,
+    /// Parameter sets simulated so far.
+    evaluations: AtomicU64,
+}
+
+impl Clone for Problem {
+    fn clone(&self) -> Self {
+        Problem {
+            machine: self.machine.clone(),
+            params: self.params.clone(),
+            tests: self.tests.clone(),
+            settings: self.settings.clone(),
+            prediction: self.prediction.clone(),
+            evaluations: AtomicU64::new(self.evaluations()),
+        }
+    }
 }
 
 impl Problem {
@@ -109,6 +125,7 @@ impl Problem {
             tests,
             settings,
             prediction,
+            evaluations: AtomicU64::new(0),
         })
     }
 
@@ -130,6 +147,16 @@ impl Problem {
     /// The settings.
     pub fn settings(&self) -> &Settings {
         &self.settings
+    }
+
+    /// The circle centre test `index` is simulated at, m (machine axis order).
+    pub fn position_m(&self, index: usize) -> &[f64] {
+        self.prediction.position_m(index)
+    }
+
+    /// Parameter sets simulated so far (every set counts once, whatever the number of tests).
+    pub fn evaluations(&self) -> u64 {
+        self.evaluations.load(Ordering::Relaxed)
     }
 
     /// θ = 1/p of the starting machine.
@@ -171,6 +198,8 @@ impl Problem {
         thetas: &[DVector<f64>],
         solver: SolverKind,
     ) -> Result<Vec<Vec<EijMap>>, IdentError> {
+        self.evaluations
+            .fetch_add(thetas.len() as u64, Ordering::Relaxed);
         let machines: Vec<Machine> = thetas.iter().map(|t| self.machine_at(t)).collect();
         self.prediction
             .simulate_with(&machines, solver)

@@ -1,9 +1,12 @@
-//! Outputs of an identification: the identified machine file and the report JSON
-//! (CONTRACT.md keys).
+//! Outputs of an identification, one serde type per file, written and read by the same type:
+//! the report JSON ([`IdentReport`], CONTRACT.md keys) and the identified machine file with its
+//! `[provenance]` table ([`machine_toml`], [`crate::machine::raw::RawProvenance`]).
 
-use super::{IdentResult, Problem, Settings};
-use crate::rtest::eij_json;
-use serde_json::{json, Value};
+use super::{IdentResult, Method, Problem, Settings, SolverKind};
+use crate::axes::{Direction, Eij, Plane};
+use crate::machine::raw::{RawProvenance, RawProvenanceParameter};
+use serde::{Deserialize, Deserializer, Serialize};
+use std::collections::BTreeMap;
 
 /// Provenance written into exports: what produced them and when.
 #[derive(Debug, Clone, PartialEq)]
@@ -32,91 +35,371 @@ impl Provenance {
     }
 }
 
-fn settings_json(s: &Settings) -> Value {
-    json!({
-        "method": s.method,
-        "solver": s.simulation.solver,
-        "rate_hz": s.simulation.rate_hz,
-        "revolutions": s.simulation.revolutions,
-        "min_factor": s.min_factor,
-        "max_factor": s.max_factor,
-        "max_iters": s.max_iters(),
-        "tol_cost": s.tol_cost,
-        "tol_step": s.tol_step,
-        "fd_step": s.fd_step,
-        "sigma_floor_um_s2_per_m": s.sigma_floor,
-    })
+/// EIJ values by parameter, µm·s²/m. A value a simulation lacks is NaN, written as `null`.
+pub type EijValues = BTreeMap<Eij, f64>;
+
+/// `null` read as NaN (serde_json writes NaN as `null`).
+fn nan_values<'de, D: Deserializer<'de>>(d: D) -> Result<EijValues, D::Error> {
+    let m = BTreeMap::<Eij, Option<f64>>::deserialize(d)?;
+    Ok(m.into_iter()
+        .map(|(k, v)| (k, v.unwrap_or(f64::NAN)))
+        .collect())
 }
 
-/// The report JSON: parameters with standard errors and correlations, costs, and per test the
-/// measured and simulated EIJ before and after, with the simulated/measured ratios.
-pub fn report_json(problem: &Problem, result: &IdentResult, prov: &Provenance) -> Value {
-    let n = result.parameters.len();
-    let tests: Vec<Value> = problem
-        .tests()
-        .iter()
-        .enumerate()
-        .map(|(i, t)| {
-            let measured: std::collections::BTreeMap<_, _> =
-                t.measured.iter().map(|(p, (v, _))| (*p, *v)).collect();
-            let sigma: std::collections::BTreeMap<_, _> =
-                t.measured.iter().map(|(p, (_, s))| (*p, *s)).collect();
-            let ratio = |sim: &std::collections::BTreeMap<crate::axes::Eij, f64>| {
-                let r: std::collections::BTreeMap<_, _> = measured
-                    .iter()
-                    .filter(|(_, m)| m.abs() > 0.0)
-                    .map(|(p, m)| (*p, sim.get(p).copied().unwrap_or(f64::NAN) / m))
-                    .collect();
-                eij_json(&r)
-            };
-            let only_measured = |sim: &std::collections::BTreeMap<crate::axes::Eij, f64>| {
-                let r: std::collections::BTreeMap<_, _> = measured
-                    .keys()
-                    .map(|p| (*p, sim.get(p).copied().unwrap_or(f64::NAN)))
-                    .collect();
-                eij_json(&r)
-            };
-            json!({
-                "source": t.source,
-                "plane": t.circle.plane.name(),
-                "direction": t.circle.direction.name(),
-                "radius_mm": t.circle.radius_mm,
-                "accel_m_s2": t.circle.accel_m_s2,
-                "measured": eij_json(&measured),
-                "measured_std_err": eij_json(&sigma),
-                "simulated_initial": only_measured(&result.simulated_initial[i]),
-                "simulated_final": only_measured(&result.simulated_final[i]),
-                "simulated_final_time_domain": result.simulated_final_time.as_ref().map(|t| only_measured(&t[i])),
-                "ratio_initial": ratio(&result.simulated_initial[i]),
-                "ratio_final": ratio(&result.simulated_final[i]),
+/// As [`nan_values`], for an optional map.
+fn nan_values_opt<'de, D: Deserializer<'de>>(d: D) -> Result<Option<EijValues>, D::Error> {
+    let m = Option::<BTreeMap<Eij, Option<f64>>>::deserialize(d)?;
+    Ok(m.map(|m| {
+        m.into_iter()
+            .map(|(k, v)| (k, v.unwrap_or(f64::NAN)))
+            .collect()
+    }))
+}
+
+/// As [`nan_values`], for a matrix.
+fn nan_matrix<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<Vec<f64>>, D::Error> {
+    let m = Vec::<Vec<Option<f64>>>::deserialize(d)?;
+    Ok(m.into_iter()
+        .map(|row| row.into_iter().map(|v| v.unwrap_or(f64::NAN)).collect())
+        .collect())
+}
+
+/// The report JSON of `eij identify` (CONTRACT.md): parameters with standard errors and
+/// correlations, costs, warnings, settings, and per test the measured and simulated EIJ before
+/// and after. Keys that older reports may lack are optional for reading; `eij identify` writes
+/// every one.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct IdentReport {
+    /// Version of eij that wrote it.
+    #[serde(default)]
+    pub eij_version: String,
+    /// UTC time stamp (RFC 3339).
+    #[serde(default)]
+    pub date: String,
+    /// The machine file identified.
+    #[serde(default)]
+    pub machine: Option<String>,
+    /// The measured inputs.
+    #[serde(default)]
+    pub measured_inputs: Vec<String>,
+    /// Identified parameters, in the order given.
+    pub parameters: Vec<ParameterReport>,
+    /// Correlation matrix of the parameters (rows and columns in parameter order; 0 for a
+    /// parameter that is not identifiable).
+    #[serde(deserialize_with = "nan_matrix")]
+    pub correlation: Vec<Vec<f64>>,
+    /// Singular values of the weighted Jacobian ∂r/∂θ at the solution, descending.
+    #[serde(default)]
+    pub jacobian_singular_values: Vec<f64>,
+    /// Σr² at the start.
+    pub cost_initial: f64,
+    /// Σr² at the solution.
+    pub cost_final: f64,
+    /// Σr² at the start and after every iteration (`[cost_initial, cost_final]` when absent).
+    #[serde(default)]
+    pub cost_history: Vec<f64>,
+    /// What the cost is.
+    #[serde(default)]
+    pub cost_definition: String,
+    /// Parameter sets simulated.
+    #[serde(default)]
+    pub evaluations: Option<u64>,
+    /// Residual standard deviation s = √(Σr²/(m − n)).
+    #[serde(default)]
+    pub residual_std: Option<f64>,
+    /// Number of residuals m.
+    #[serde(default)]
+    pub residuals: Option<usize>,
+    /// Iterations of the optimiser.
+    #[serde(default)]
+    pub iterations: Option<u64>,
+    /// Warnings (also printed on standard error).
+    #[serde(default)]
+    pub warnings: Vec<String>,
+    /// The settings of the run.
+    #[serde(default)]
+    pub settings: Option<SettingsReport>,
+    /// The tests fitted.
+    pub tests: Vec<TestReport>,
+}
+
+/// One parameter of [`IdentReport`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ParameterReport {
+    /// Name, e.g. `z.guideway_normal`.
+    pub name: String,
+    /// Start value.
+    pub initial: f64,
+    /// Identified value (the start value when not identifiable).
+    pub identified: f64,
+    /// Standard error, `null` when not identifiable.
+    pub std_err: Option<f64>,
+    /// Whether the tests determine it.
+    #[serde(default)]
+    pub identifiable: Option<bool>,
+    /// Whether it ended on a bound of the factors.
+    #[serde(default)]
+    pub at_bound: Option<bool>,
+}
+
+/// The settings of the run in [`IdentReport`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SettingsReport {
+    /// Optimiser.
+    pub method: Method,
+    /// How the tests were simulated during the optimisation.
+    pub solver: SolverKind,
+    /// Output rate of time-domain simulations, Hz.
+    pub rate_hz: f64,
+    /// Steady revolutions per simulated test.
+    pub revolutions: u32,
+    /// Lower bound of the factors.
+    pub min_factor: f64,
+    /// Upper bound of the factors.
+    pub max_factor: f64,
+    /// Iteration limit.
+    pub max_iters: u64,
+    /// Relative cost decrease that counts as converged.
+    pub tol_cost: f64,
+    /// Step in θ = 1/p that counts as converged.
+    pub tol_step: f64,
+    /// Central-difference step, relative to θ.
+    pub fd_step: f64,
+    /// Smallest σ used to weight a measured value, µm·s²/m.
+    pub sigma_floor_um_s2_per_m: f64,
+}
+
+impl From<&Settings> for SettingsReport {
+    fn from(s: &Settings) -> Self {
+        SettingsReport {
+            method: s.method,
+            solver: s.simulation.solver,
+            rate_hz: s.simulation.rate_hz,
+            revolutions: s.simulation.revolutions,
+            min_factor: s.min_factor,
+            max_factor: s.max_factor,
+            max_iters: s.max_iters(),
+            tol_cost: s.tol_cost,
+            tol_step: s.tol_step,
+            fd_step: s.fd_step,
+            sigma_floor_um_s2_per_m: s.sigma_floor,
+        }
+    }
+}
+
+/// One test of [`IdentReport`]: its conditions and the measured and simulated EIJ, µm·s²/m.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TestReport {
+    /// Source file or table rows.
+    #[serde(default)]
+    pub source: Option<String>,
+    /// Plane.
+    pub plane: Plane,
+    /// Direction.
+    pub direction: Direction,
+    /// Set radius, mm.
+    #[serde(default)]
+    pub radius_mm: Option<f64>,
+    /// Set acceleration, m/s².
+    pub accel_m_s2: f64,
+    /// Circle frequency √(a/r)/2π, Hz.
+    #[serde(default)]
+    pub freq_hz: Option<f64>,
+    /// Axis positions of the circle centre the test was simulated at, mm (machine axis order).
+    #[serde(default)]
+    pub position_mm: Option<Vec<f64>>,
+    /// Measured EIJ.
+    #[serde(deserialize_with = "nan_values")]
+    pub measured: EijValues,
+    /// Their standard errors (σ of the weighting before the floor).
+    #[serde(default, deserialize_with = "nan_values")]
+    pub measured_std_err: EijValues,
+    /// Simulated with the starting factors.
+    #[serde(deserialize_with = "nan_values")]
+    pub simulated_initial: EijValues,
+    /// Simulated with the identified factors.
+    #[serde(deserialize_with = "nan_values")]
+    pub simulated_final: EijValues,
+    /// The same in the time domain (confirmation of a harmonic optimisation).
+    #[serde(default, deserialize_with = "nan_values_opt")]
+    pub simulated_final_time_domain: Option<EijValues>,
+    /// simulated_initial / measured (measured values ≠ 0).
+    #[serde(default, deserialize_with = "nan_values")]
+    pub ratio_initial: EijValues,
+    /// simulated_final / measured (measured values ≠ 0).
+    #[serde(default, deserialize_with = "nan_values")]
+    pub ratio_final: EijValues,
+}
+
+/// A report JSON that cannot be read: the key path (`tests[1].simulated_final`) and what is
+/// wrong.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("key `{key}`: {message}")]
+pub struct ReportKeyError {
+    /// Path of the key.
+    pub key: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl IdentReport {
+    /// The report of `result` on `problem`.
+    pub fn new(problem: &Problem, result: &IdentResult, prov: &Provenance) -> IdentReport {
+        let tests = problem
+            .tests()
+            .iter()
+            .enumerate()
+            .map(|(i, t)| {
+                let measured: EijValues = t.measured.iter().map(|(p, (v, _))| (*p, *v)).collect();
+                let only_measured = |sim: &EijValues| -> EijValues {
+                    measured
+                        .keys()
+                        .map(|p| (*p, sim.get(p).copied().unwrap_or(f64::NAN)))
+                        .collect()
+                };
+                let ratio = |sim: &EijValues| -> EijValues {
+                    measured
+                        .iter()
+                        .filter(|(_, m)| m.abs() > 0.0)
+                        .map(|(p, m)| (*p, sim.get(p).copied().unwrap_or(f64::NAN) / m))
+                        .collect()
+                };
+                TestReport {
+                    source: Some(t.source.clone()),
+                    plane: t.circle.plane,
+                    direction: t.circle.direction,
+                    radius_mm: Some(t.circle.radius_mm),
+                    accel_m_s2: t.circle.accel_m_s2,
+                    freq_hz: Some(t.circle.freq_hz()),
+                    position_mm: Some(problem.position_m(i).iter().map(|v| v * 1e3).collect()),
+                    measured_std_err: t.measured.iter().map(|(p, (_, s))| (*p, *s)).collect(),
+                    simulated_initial: only_measured(&result.simulated_initial[i]),
+                    simulated_final: only_measured(&result.simulated_final[i]),
+                    simulated_final_time_domain: result
+                        .simulated_final_time
+                        .as_ref()
+                        .map(|t| only_measured(&t[i])),
+                    ratio_initial: ratio(&result.simulated_initial[i]),
+                    ratio_final: ratio(&result.simulated_final[i]),
+                    measured,
+                }
             })
-        })
-        .collect();
-    json!({
-        "eij_version": env!("CARGO_PKG_VERSION"),
-        "date": prov.date,
-        "machine": prov.machine_file,
-        "measured_inputs": prov.measured,
-        "parameters": result.parameters.iter().map(|p| json!({
-            "name": p.name,
-            "initial": p.initial,
-            "identified": p.value,
-            "std_err": p.std_err,
-            "identifiable": p.identifiable,
-        })).collect::<Vec<_>>(),
-        "correlation": (0..n).map(|i| (0..n).map(|k| result.correlation[(i, k)]).collect::<Vec<_>>()).collect::<Vec<_>>(),
-        "jacobian_singular_values": result.singular_values,
-        "cost_initial": result.cost_initial,
-        "cost_final": result.cost_final,
-        "cost_history": result.cost_history,
-        "cost_definition": "sum of squared weighted residuals ((E_sim - E_meas) / sigma)^2",
-        "residual_std": result.residual_std,
-        "residuals": result.residuals,
-        "iterations": result.iterations,
-        "warnings": result.warnings,
-        "settings": settings_json(problem.settings()),
-        "tests": tests,
-    })
+            .collect();
+        let n = result.parameters.len();
+        IdentReport {
+            eij_version: env!("CARGO_PKG_VERSION").into(),
+            date: prov.date.clone(),
+            machine: Some(prov.machine_file.clone()),
+            measured_inputs: prov.measured.clone(),
+            parameters: result
+                .parameters
+                .iter()
+                .map(|p| ParameterReport {
+                    name: p.name.clone(),
+                    initial: p.initial,
+                    identified: p.value,
+                    std_err: p.std_err,
+                    identifiable: Some(p.identifiable),
+                    at_bound: Some(p.at_bound),
+                })
+                .collect(),
+            correlation: (0..n)
+                .map(|i| (0..n).map(|k| result.correlation[(i, k)]).collect())
+                .collect(),
+            jacobian_singular_values: result.singular_values.clone(),
+            cost_initial: result.cost_initial,
+            cost_final: result.cost_final,
+            cost_history: result.cost_history.clone(),
+            cost_definition: "sum of squared weighted residuals ((E_sim - E_meas) / sigma)^2"
+                .into(),
+            evaluations: Some(result.evaluations),
+            residual_std: Some(result.residual_std),
+            residuals: Some(result.residuals),
+            iterations: Some(result.iterations),
+            warnings: result.warnings.clone(),
+            settings: Some(problem.settings().into()),
+            tests,
+        }
+    }
+
+    /// The JSON text (pretty, with a final line end).
+    pub fn to_json(&self) -> Vec<u8> {
+        let mut json = serde_json::to_vec_pretty(self).unwrap_or_default();
+        json.push(b'\n');
+        json
+    }
+
+    /// Reads a report, naming the first missing or malformed key; a missing `cost_history` is
+    /// taken as `[cost_initial, cost_final]`.
+    pub fn from_json(bytes: &[u8]) -> Result<IdentReport, ReportKeyError> {
+        let de = &mut serde_json::Deserializer::from_slice(bytes);
+        let mut r: IdentReport = serde_path_to_error::deserialize(de).map_err(|e| {
+            let path = e.path().to_string();
+            let inner = e.into_inner();
+            let (line, column) = (inner.line(), inner.column());
+            let text = inner.to_string();
+            let text = text
+                .strip_suffix(&format!(" at line {line} column {column}"))
+                .unwrap_or(&text);
+            // A missing field is named as a key of its own: `tests[1].simulated_final`.
+            let (key, message) = match text
+                .strip_prefix("missing field `")
+                .and_then(|f| f.strip_suffix('`'))
+            {
+                Some(field) if path == "." => (field.to_string(), "missing".to_string()),
+                Some(field) => (format!("{path}.{field}"), "missing".to_string()),
+                None => (path, text.to_string()),
+            };
+            ReportKeyError {
+                key,
+                message: format!("{message} (line {line}, column {column})"),
+            }
+        })?;
+        r.check()?;
+        Ok(r)
+    }
+
+    /// As [`IdentReport::from_json`] from a parsed JSON value.
+    pub fn from_value(value: &serde_json::Value) -> Result<IdentReport, ReportKeyError> {
+        IdentReport::from_json(value.to_string().as_bytes())
+    }
+
+    /// What the types cannot say: a square correlation matrix over the parameters, a test.
+    fn check(&mut self) -> Result<(), ReportKeyError> {
+        let bad = |key: String, message: String| ReportKeyError { key, message };
+        let n = self.parameters.len();
+        if self.correlation.len() != n {
+            return Err(bad(
+                "correlation".into(),
+                format!("{} rows for {n} parameters", self.correlation.len()),
+            ));
+        }
+        if let Some(i) = self.correlation.iter().position(|r| r.len() != n) {
+            return Err(bad(
+                format!("correlation[{i}]"),
+                format!("expected a row of {n} numbers"),
+            ));
+        }
+        if self.tests.is_empty() {
+            return Err(bad("tests".into(), "no tests".into()));
+        }
+        if self.cost_history.is_empty() {
+            self.cost_history = vec![self.cost_initial, self.cost_final];
+        }
+        Ok(())
+    }
+
+    /// The EIJ measured in at least one test, in parameter order.
+    pub fn eij_parameters(&self) -> Vec<Eij> {
+        let mut all: Vec<Eij> = self
+            .tests
+            .iter()
+            .flat_map(|t| t.measured.keys().copied())
+            .collect();
+        all.sort();
+        all.dedup();
+        all
+    }
 }
 
 /// The identified machine as TOML text: the machine file with the identified factors, a
@@ -125,37 +408,32 @@ pub fn machine_toml(
     problem: &Problem,
     result: &IdentResult,
     prov: &Provenance,
-) -> Result<String, String> {
+) -> Result<String, toml::ser::Error> {
     let mut raw = result.machine.to_raw();
-    let mut p = toml::Table::new();
-    p.insert(
-        "identified_by".into(),
-        format!("eij {}", env!("CARGO_PKG_VERSION")).into(),
-    );
-    p.insert("date".into(), prov.date.clone().into());
-    p.insert("from_machine".into(), prov.machine_file.clone().into());
-    p.insert(
-        "measured".into(),
-        toml::Value::Array(prov.measured.iter().map(|m| m.clone().into()).collect()),
-    );
-    p.insert("tests".into(), (problem.tests().len() as i64).into());
-    p.insert("cost_initial".into(), result.cost_initial.into());
-    p.insert("cost_final".into(), result.cost_final.into());
-    let mut params = toml::Table::new();
-    for q in &result.parameters {
-        let mut e = toml::Table::new();
-        e.insert("initial".into(), q.initial.into());
-        e.insert("identified".into(), q.value.into());
-        if let Some(s) = q.std_err {
-            e.insert("std_err".into(), s.into());
-        }
-        e.insert("identifiable".into(), q.identifiable.into());
-        params.insert(q.name.clone(), toml::Value::Table(e));
-    }
-    p.insert("parameters".into(), toml::Value::Table(params));
-    raw.provenance = Some(p);
+    raw.provenance = Some(RawProvenance {
+        cost_final: result.cost_final,
+        cost_initial: result.cost_initial,
+        date: prov.date.clone(),
+        from_machine: prov.machine_file.clone(),
+        identified_by: format!("eij {}", env!("CARGO_PKG_VERSION")),
+        measured: prov.measured.clone(),
+        parameters: result
+            .parameters
+            .iter()
+            .map(|q| {
+                let entry = RawProvenanceParameter {
+                    identifiable: q.identifiable,
+                    identified: q.value,
+                    initial: q.initial,
+                    std_err: q.std_err,
+                };
+                (q.name.clone(), entry)
+            })
+            .collect(),
+        tests: problem.tests().len(),
+    });
     raw.name = format!("{}-identified", problem.machine().name);
-    let body = toml::to_string_pretty(&raw).map_err(|e| e.to_string())?;
+    let body = toml::to_string_pretty(&raw)?;
     let mut header = format!(
         "# Identified by eij {} on {} from {} and {} measured input(s).\n",
         env!("CARGO_PKG_VERSION"),

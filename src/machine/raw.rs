@@ -32,9 +32,9 @@ pub struct RawMachine {
     /// Stiffness-proportional (Rayleigh) damping D += β·K, in s.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub rayleigh_beta_s: f64,
-    /// Where the file came from (written by `eij identify`); free-form.
+    /// Where the file came from (written by `eij identify`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub provenance: Option<toml::Table>,
+    pub provenance: Option<RawProvenance>,
     /// Tool centre point: a point of the tool-side body.
     pub tcp: RawBodyPoint,
     /// Workpiece point (R-Test nest): a point of the workpiece-side body.
@@ -279,4 +279,42 @@ pub struct RawCarriage {
     pub estimated: Vec<String>,
     /// Published source.
     pub source: String,
+}
+
+/// The `[provenance]` table of an identified machine file: what produced it, from what, and
+/// the identified factors (fields in alphabetical order, as TOML tables list them).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawProvenance {
+    /// Σr² at the solution.
+    pub cost_final: f64,
+    /// Σr² at the start.
+    pub cost_initial: f64,
+    /// UTC time stamp (RFC 3339).
+    pub date: String,
+    /// The machine file identified.
+    pub from_machine: String,
+    /// `eij <version>`.
+    pub identified_by: String,
+    /// The measured inputs.
+    pub measured: Vec<String>,
+    /// Identified factors by parameter name.
+    pub parameters: std::collections::BTreeMap<String, RawProvenanceParameter>,
+    /// Number of circle tests fitted.
+    pub tests: usize,
+}
+
+/// One identified factor in [`RawProvenance`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawProvenanceParameter {
+    /// Whether the tests determine it.
+    pub identifiable: bool,
+    /// Identified value.
+    pub identified: f64,
+    /// Start value.
+    pub initial: f64,
+    /// Standard error (absent when not identifiable).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub std_err: Option<f64>,
 }

@@ -13,9 +13,10 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use super::ident_plot::IdentReport;
+use super::ident_plot::test_label;
 use super::{identification_svg, move_svg, short, CircleView, Conditions, MoveData, ReportError};
 use crate::axes::Plane;
+use crate::ident::report::IdentReport;
 use crate::rtest::conditions::TestConditions;
 use crate::rtest::{self, CircleResult, CircleSeries, EvalOptions};
 
@@ -166,20 +167,17 @@ fn evaluate_file(path: &Path, index: usize) -> Result<CircleEntry, ReportError> 
 fn read_identification(path: &Path) -> Result<(IdentReport, Figure), ReportError> {
     let name = path.display().to_string();
     let bytes = super::read_file(path)?;
-    let value: serde_json::Value =
-        serde_json::from_slice(&bytes).map_err(|e| ReportError::BadInput {
-            source_name: name.clone(),
+    if let Err(e) = serde_json::from_slice::<serde::de::IgnoredAny>(&bytes) {
+        return Err(ReportError::BadInput {
+            source_name: name,
             message: format!("not valid JSON: {e}"),
-        })?;
-    let in_file = |e: ReportError| match e {
-        ReportError::Key { key, message } => ReportError::BadInput {
-            source_name: name.clone(),
-            message: format!("key `{key}`: {message}"),
-        },
-        other => other,
-    };
-    let rep = IdentReport::parse(&value).map_err(in_file)?;
-    let svg = identification_svg(&value).map_err(in_file)?;
+        });
+    }
+    let rep = IdentReport::from_json(&bytes).map_err(|e| ReportError::BadInput {
+        source_name: name.clone(),
+        message: e.to_string(),
+    })?;
+    let svg = identification_svg(&rep)?;
     Ok((
         rep,
         Figure {
@@ -512,7 +510,7 @@ fn identification_html(h: &mut String, rep: &IdentReport, fig: &Figure) {
                 h,
                 "<tr><td>{}</td><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{p}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
                 i + 1,
-                escape(&t.label()),
+                escape(&test_label(t)),
                 escape(&source),
                 fmt_eij(*m),
                 fmt_eij(t.measured_std_err.get(p).copied().unwrap_or(f64::NAN)),

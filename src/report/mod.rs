@@ -68,14 +68,6 @@ pub enum ReportError {
         /// What is wrong.
         message: String,
     },
-    /// The identification report lacks a key or holds a value of the wrong kind.
-    #[error("identification report: key `{key}`: {message}")]
-    Key {
-        /// JSON path of the key, e.g. `tests[3].measured`.
-        key: String,
-        /// What is wrong.
-        message: String,
-    },
     /// Drawing failed (plotters).
     #[error("drawing {figure}: {message}")]
     Plot {
