@@ -77,6 +77,10 @@ pub struct IdentifyArgs {
         allow_hyphen_values = true
     )]
     position_mm: Option<Vec<f64>>,
+    /// Also write the identified stiffness set as a table (CSV: catalogue value, factor,
+    /// identified value and its standard error in N/µm per axis, element and direction).
+    #[arg(long, value_name = "F.csv")]
+    stiffness_out: Option<PathBuf>,
     /// Also draw the identification figure (measured vs simulated EIJ before and after per
     /// test, cost over iterations) as SVG.
     #[arg(long, value_name = "FILE.svg")]
@@ -315,6 +319,7 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
     let outputs: Vec<&Path> = [
         Some(args.out.as_path()),
         Some(args.report.as_path()),
+        args.stiffness_out.as_deref(),
         args.plot.as_deref(),
     ]
     .into_iter()
@@ -334,6 +339,10 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
     let json = ident_report.to_json();
     write_output(&args.out, toml_text.as_bytes(), &input_refs)?;
     write_output(&args.report, &json, &input_refs)?;
+    if let Some(path) = &args.stiffness_out {
+        let table = eij::ident::stiffness::identified_table(&prep.problem, &result);
+        write_output(path, &table.to_csv(), &input_refs)?;
+    }
     if let (Some(path), Some(svg)) = (&args.plot, &svg) {
         write_output(path, svg.as_bytes(), &input_refs)?;
     }

@@ -11,6 +11,7 @@ mod map;
 mod modal;
 mod report;
 mod simulate;
+mod stiffness;
 
 /// eij — acceleration correlated position errors of machine tools from R-Test circle tests.
 #[derive(Debug, Parser)]
@@ -36,6 +37,8 @@ enum Command {
     Verify(identify::VerifyArgs),
     /// EIJ over a grid of axis positions (compensation table).
     Map(map::MapArgs),
+    /// The stiffness set of a machine file as a table (catalogue × factor, N/µm).
+    Stiffness(stiffness::StiffnessArgs),
     /// Write an offline HTML report with SVG figures (circle tests, moves, identification).
     Report(report::ReportArgs),
 }
@@ -52,6 +55,7 @@ impl Cli {
             Command::Verify(args) => identify::verify(args),
             Command::Map(args) => map::run(args),
             Command::Report(args) => report::run(args),
+            Command::Stiffness(args) => stiffness::run(args),
         }
     }
 }

@@ -17,7 +17,8 @@
 //! The parts: [`parameters`] (what is fitted), [`problem`] (residuals, Jacobian, argmin
 //! traits), [`lm`] (the Levenberg–Marquardt solver), [`uncertainty`], [`settings`] (every
 //! default), [`measured`] (reading measured EIJ), [`config`] and [`report`] (files), and
-//! [`identify`], which runs them in order.
+//! [`identify`], which runs them in order; [`stiffness`] gives the identified stiffness set as a
+//! table.
 
 pub mod config;
 mod error;
@@ -27,6 +28,7 @@ pub mod parameters;
 pub mod problem;
 pub mod report;
 pub mod settings;
+pub mod stiffness;
 pub mod uncertainty;
 
 pub use crate::predict::{EijMap, SolverKind};

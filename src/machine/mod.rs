@@ -7,6 +7,7 @@
 
 pub mod catalogue;
 pub mod raw;
+pub mod stiffness;
 
 use crate::axes::Axis;
 use catalogue::{CarriageData, Catalogue};

@@ -1,0 +1,94 @@
+//! `eij stiffness --machine FILE.toml [--out F.csv]`: the stiffness set of a machine file as a
+//! table (docs/stiffness-table.md).
+
+use super::machine_args::write_output;
+use eij::ident::stiffness::machine_table;
+use eij::machine::stiffness::StiffnessTable;
+use eij::machine::Machine;
+use std::path::PathBuf;
+
+/// Arguments of `eij stiffness`.
+#[derive(Debug, clap::Args)]
+pub struct StiffnessArgs {
+    /// Machine description (the catalogue model or an identified one).
+    #[arg(long, value_name = "FILE.toml")]
+    machine: PathBuf,
+    /// The table as CSV (default: a readable table on standard output).
+    #[arg(long, value_name = "F.csv")]
+    out: Option<PathBuf>,
+}
+
+/// Runs `eij stiffness`.
+pub fn run(args: StiffnessArgs) -> anyhow::Result<()> {
+    if let Some(out) = &args.out {
+        eij::io::check_outputs(&[out.as_path()], &[args.machine.as_path()])?;
+    }
+    let machine = Machine::from_file(&args.machine)?;
+    let (table, warnings) = machine_table(&machine);
+    for w in &warnings {
+        eprintln!("warning: {w}");
+    }
+    match &args.out {
+        Some(out) => write_output(out, &table.to_csv(), &[args.machine.as_path()]),
+        None => {
+            print!("{}", text(&machine, &table));
+            Ok(())
+        }
+    }
+}
+
+/// The table for reading: aligned columns, and where each screw value holds.
+pub fn text(machine: &Machine, table: &StiffnessTable) -> String {
+    let mut s = format!(
+        "Stiffness of {} (N/µm per element; value = file × factor)\n\n",
+        machine.name
+    );
+    s.push_str(&format!(
+        "  {:<4} {:<9} {:<9} {:>5} {:>10} {:>8} {:>10}",
+        "axis", "element", "direction", "count", "file", "factor", "value"
+    ));
+    if table.identified {
+        s.push_str(&format!(" {:>10}  {}", "std err", "parameter"));
+    }
+    s.push('\n');
+    for r in &table.rows {
+        s.push_str(&format!(
+            "  {:<4} {:<9} {:<9} {:>5} {:>10.1} {:>8.4} {:>10.1}",
+            r.axis.name(),
+            r.element.name(),
+            r.direction.name(),
+            r.count,
+            r.file_n_per_um,
+            r.factor,
+            r.value_n_per_um
+        ));
+        if table.identified {
+            let std_err = r.std_err_n_per_um.map_or("-".into(), |e| format!("{e:.1}"));
+            s.push_str(&format!(
+                " {std_err:>10}  {}",
+                r.parameter.as_deref().unwrap_or("-")
+            ));
+        }
+        s.push('\n');
+    }
+    let screws: Vec<String> = table
+        .rows
+        .iter()
+        .filter_map(|r| r.screw.map(|p| (r.axis, p)))
+        .map(|(axis, p)| {
+            format!(
+                "  {axis}: nut {:.0} mm from the fixed bearing at {axis} = {:.1} mm; value {:.1} … {:.1} N/µm over the stroke",
+                p.nut_bearing_mm,
+                p.axis_position_mm,
+                p.stroke_range_n_per_um[0],
+                p.stroke_range_n_per_um[1]
+            )
+        })
+        .collect();
+    if !screws.is_empty() {
+        s.push_str("\nScrew shafts at the reference position (E·A/l₁ follows the nut):\n");
+        s.push_str(&screws.join("\n"));
+        s.push('\n');
+    }
+    s
+}

@@ -1,0 +1,121 @@
+//! The stiffness table of an identified machine ([`crate::machine::stiffness`]) with the
+//! standard errors of the identified factors: from the identification itself, or from the
+//! `[provenance]` an identified machine file carries — so that `eij stiffness` of the exported
+//! file gives exactly the table `eij identify --stiffness-out` wrote.
+
+use super::{IdentResult, Parameter, ParameterKind, Problem};
+use crate::machine::stiffness::{FactorKind, StiffnessTable};
+use crate::machine::Machine;
+
+impl ParameterKind {
+    /// The reduction factors of its axis a parameter of this kind sets.
+    pub fn factors(self) -> &'static [FactorKind] {
+        match self {
+            ParameterKind::Guideway => &[FactorKind::GuidewayNormal, FactorKind::GuidewayLateral],
+            ParameterKind::GuidewayNormal => &[FactorKind::GuidewayNormal],
+            ParameterKind::GuidewayLateral => &[FactorKind::GuidewayLateral],
+            ParameterKind::Screw => &[FactorKind::Drive],
+        }
+    }
+}
+
+/// The stiffness table of `machine` with, for every fitted parameter, its name and the standard
+/// error of its factor (`None`: not determined by the tests) on the rows it scales.
+pub fn table_with_std_err<'a>(
+    machine: &Machine,
+    fitted: impl IntoIterator<Item = (&'a Parameter, Option<f64>)>,
+) -> StiffnessTable {
+    let mut table = StiffnessTable::of(machine);
+    table.identified = true;
+    for (p, std_err) in fitted {
+        let axis = machine.axes[p.axis_index].axis;
+        for &kind in p.kind.factors() {
+            table.set_factor_std_err(axis, kind, &p.name, std_err);
+        }
+    }
+    table
+}
+
+/// The stiffness table of an identification's result: the identified machine with the standard
+/// errors of the identified factors.
+pub fn identified_table(problem: &Problem, result: &IdentResult) -> StiffnessTable {
+    table_with_std_err(
+        &result.machine,
+        problem
+            .parameters()
+            .iter()
+            .zip(&result.parameters)
+            .map(|(p, r)| (p, r.std_err)),
+    )
+}
+
+/// The stiffness table of a machine file: with the standard errors its `[provenance]` records
+/// when it is an identified file, and warnings for recorded factors that no longer hold (the
+/// file was edited after the identification; their standard errors are left out).
+pub fn machine_table(machine: &Machine) -> (StiffnessTable, Vec<String>) {
+    let Some(provenance) = machine.to_raw().provenance else {
+        return (StiffnessTable::of(machine), Vec::new());
+    };
+    let Some(recorded) = provenance.get("parameters").and_then(|p| p.as_table()) else {
+        return (StiffnessTable::of(machine), Vec::new());
+    };
+    let mut warnings = Vec::new();
+    let mut fitted = Vec::new();
+    for (name, entry) in recorded {
+        let number = |key: &str| entry.get(key).and_then(|v| v.as_float());
+        let parameter = match Parameter::parse(name, machine) {
+            Ok(p) => p,
+            Err(e) => {
+                warnings.push(format!(
+                    "{}: provenance: {e}; its standard error is left out",
+                    machine.source
+                ));
+                continue;
+            }
+        };
+        let now = parameter.get(machine);
+        if number("identified") != Some(now) {
+            warnings.push(format!(
+                "{}: {name} = {now} differs from the identified {} recorded in [provenance]: its standard error is left out",
+                machine.source,
+                number("identified").map_or("(none)".to_string(), |v| v.to_string())
+            ));
+            continue;
+        }
+        fitted.push((parameter, number("std_err")));
+    }
+    (
+        table_with_std_err(machine, fitted.iter().map(|(p, s)| (p, *s))),
+        warnings,
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::axes::Axis;
+    use crate::machine::stiffness::Element;
+
+    #[test]
+    fn a_parameter_scales_its_rows_only() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("machines/demo-vmc.toml");
+        let m = Machine::from_file(&path).unwrap();
+        let screw = Parameter::parse("y.screw", &m).unwrap();
+        let guide = Parameter::parse("z.guideway", &m).unwrap();
+        let t = table_with_std_err(&m, [(&screw, Some(0.1)), (&guide, None)]);
+        assert!(t.identified);
+        for r in &t.rows {
+            match (r.axis, r.element) {
+                (Axis::Y, Element::Screw | Element::Nut | Element::Bearing) => {
+                    assert_eq!(r.std_err_n_per_um, Some(0.1 * r.file_n_per_um));
+                    assert_eq!(r.parameter.as_deref(), Some("y.screw"));
+                }
+                (Axis::Z, Element::Guideway) => {
+                    assert_eq!(r.std_err_n_per_um, None);
+                    assert_eq!(r.parameter.as_deref(), Some("z.guideway"));
+                }
+                _ => assert_eq!((&r.std_err_n_per_um, &r.parameter), (&None, &None)),
+            }
+        }
+    }
+}
