@@ -359,11 +359,19 @@ mod tests {
                     .unwrap()
                     .value_n_per_um
             };
-            let series =
-                1.0 / (1.0 / value(Element::Screw) + 1.0 / value(Element::Nut) + 1.0 / value(Element::Bearing));
-            let l1 = (a.drive.nut_m - a.drive.bearing_m).dot(&a.direction()).abs();
+            let series = 1.0
+                / (1.0 / value(Element::Screw)
+                    + 1.0 / value(Element::Nut)
+                    + 1.0 / value(Element::Bearing));
+            let l1 = (a.drive.nut_m - a.drive.bearing_m)
+                .dot(&a.direction())
+                .abs();
             let model = a.drive.axial_stiffness_n_per_m(l1) / 1e6;
-            assert!((series / model - 1.0).abs() < 1e-12, "{}: {series} vs {model}", a.axis);
+            assert!(
+                (series / model - 1.0).abs() < 1e-12,
+                "{}: {series} vs {model}",
+                a.axis
+            );
         }
     }
 
