@@ -242,6 +242,53 @@ fn identified_table_is_catalogue_times_factor_and_the_exported_file_gives_it_aga
     assert_eq!(num(z, "file_n_per_um"), 618.0);
     assert!((num(z, "value_n_per_um") / 618.0 - 0.40).abs() < 0.02);
 
+    // The report JSON holds the same rows (keys as the columns, null for an empty cell).
+    let json_rows = report["stiffness"].as_array().unwrap();
+    assert_eq!(json_rows.len(), rows.len());
+    for (j, r) in json_rows.iter().zip(&rows) {
+        for col in &header {
+            let cell = match &j[col.as_str()] {
+                serde_json::Value::Null => String::new(),
+                serde_json::Value::String(t) => t.clone(),
+                v => v.to_string(),
+            };
+            let same = match (cell.parse::<f64>(), r[col].parse::<f64>()) {
+                (Ok(a), Ok(b)) => a == b,
+                _ => cell == r[col],
+            };
+            assert!(same, "{col}: JSON {cell} vs CSV {}", r[col]);
+        }
+        assert_eq!(j.get("screw").is_some(), r["element"] == "screw");
+    }
+    let x_screw = &json_rows[2]["screw"];
+    assert_eq!(x_screw["nut_bearing_mm"].as_f64(), Some(550.0));
+
+    // ... and the HTML report shows them as a table.
+    let r = run(&[
+        "report",
+        "--measured",
+        "measurements/demo-vmc/pos-a/zx_ccw_5.csv",
+        "--identify-report",
+        &s.s("id.json"),
+        "--out",
+        &s.s("report"),
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    let html = std::fs::read_to_string(s.path("report/report.html")).unwrap();
+    let table = &html[html
+        .find("Identified stiffness")
+        .expect("no stiffness table")..];
+    let table = &table[..table.find("</table>").unwrap()];
+    assert_eq!(table.matches("<tr>").count(), 16, "header and 15 rows");
+    let z_row = format!(
+        "<td>{:.1}</td><td>{:.4}</td><td>{:.1}</td><td>{:.1}</td><td class=\"l\">z.guideway_normal</td>",
+        num(z, "file_n_per_um"),
+        num(z, "factor"),
+        num(z, "value_n_per_um"),
+        num(z, "std_err_n_per_um")
+    );
+    assert!(table.contains(&z_row), "{z_row} not in {table}");
+
     // eij stiffness of the identified machine file: the very same table, byte for byte.
     let r = run(&[
         "stiffness",

@@ -5,6 +5,7 @@
 use super::{IdentResult, Method, Problem, Settings, SolverKind};
 use crate::axes::{Direction, Eij, Plane};
 use crate::machine::raw::{RawProvenance, RawProvenanceParameter};
+use crate::machine::stiffness::StiffnessRow;
 use serde::{Deserialize, Deserializer, Serialize};
 use std::collections::BTreeMap;
 
@@ -121,6 +122,10 @@ pub struct IdentReport {
     pub settings: Option<SettingsReport>,
     /// The tests fitted.
     pub tests: Vec<TestReport>,
+    /// The identified stiffness set, one row per axis, element and direction
+    /// ([`crate::machine::stiffness`]; absent from reports of older versions).
+    #[serde(default)]
+    pub stiffness: Option<Vec<StiffnessRow>>,
 }
 
 /// One parameter of [`IdentReport`].
@@ -319,6 +324,7 @@ impl IdentReport {
             warnings: result.warnings.clone(),
             settings: Some(problem.settings().into()),
             tests,
+            stiffness: Some(super::stiffness::identified_table(problem, result).rows),
         }
     }
 

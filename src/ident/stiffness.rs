@@ -56,13 +56,9 @@ pub fn machine_table(machine: &Machine) -> (StiffnessTable, Vec<String>) {
     let Some(provenance) = machine.to_raw().provenance else {
         return (StiffnessTable::of(machine), Vec::new());
     };
-    let Some(recorded) = provenance.get("parameters").and_then(|p| p.as_table()) else {
-        return (StiffnessTable::of(machine), Vec::new());
-    };
     let mut warnings = Vec::new();
     let mut fitted = Vec::new();
-    for (name, entry) in recorded {
-        let number = |key: &str| entry.get(key).and_then(|v| v.as_float());
+    for (name, recorded) in &provenance.parameters {
         let parameter = match Parameter::parse(name, machine) {
             Ok(p) => p,
             Err(e) => {
@@ -74,15 +70,14 @@ pub fn machine_table(machine: &Machine) -> (StiffnessTable, Vec<String>) {
             }
         };
         let now = parameter.get(machine);
-        if number("identified") != Some(now) {
+        if recorded.identified != now {
             warnings.push(format!(
                 "{}: {name} = {now} differs from the identified {} recorded in [provenance]: its standard error is left out",
-                machine.source,
-                number("identified").map_or("(none)".to_string(), |v| v.to_string())
+                machine.source, recorded.identified
             ));
             continue;
         }
-        fitted.push((parameter, number("std_err")));
+        fitted.push((parameter, recorded.std_err));
     }
     (
         table_with_std_err(machine, fitted.iter().map(|(p, s)| (p, *s))),

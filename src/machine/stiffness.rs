@@ -23,13 +23,15 @@
 use super::raw::Support;
 use super::{Drive, LinearAxis, Machine};
 use crate::axes::Axis;
+use serde::{Deserialize, Serialize};
 use std::fmt;
 
 /// N/m per N/µm.
 const N_PER_M_PER_N_PER_UM: f64 = 1e6;
 
 /// The compliant element of an axis a row describes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Element {
     /// A guideway carriage (per carriage).
     Guideway,
@@ -60,7 +62,8 @@ impl fmt::Display for Element {
 }
 
 /// The direction a row's stiffness acts in.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum StiffnessDirection {
     /// Across the rail, along the carriage's normal (radial load) direction.
     Normal,
@@ -99,7 +102,7 @@ pub enum FactorKind {
 }
 
 /// Where a screw row's shaft value holds, and how it changes over the stroke.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ScrewPosition {
     /// Axis position of the row's value (the reference position), mm.
     pub axis_position_mm: f64,
@@ -109,8 +112,9 @@ pub struct ScrewPosition {
     pub stroke_range_n_per_um: [f64; 2],
 }
 
-/// One row of the table.
-#[derive(Debug, Clone, PartialEq)]
+/// One row of the table; in JSON (the identification report's `stiffness`) with the CSV's
+/// column names as keys and `screw` on screw rows.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct StiffnessRow {
     /// The axis.
     pub axis: Axis,
@@ -128,10 +132,13 @@ pub struct StiffnessRow {
     pub value_n_per_um: f64,
     /// Standard error of the value, file × standard error of the factor, N/µm; `None` when the
     /// factor was not identified or the tests do not determine it.
+    #[serde(default)]
     pub std_err_n_per_um: Option<f64>,
     /// The identified parameter that set the factor (`x.guideway_normal`), if any.
+    #[serde(default)]
     pub parameter: Option<String>,
     /// Screw rows: where the shaft value holds.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub screw: Option<ScrewPosition>,
 }
 

@@ -99,7 +99,8 @@ fn stem(path: &Path) -> String {
     }
 }
 
-fn escape(s: &str) -> String {
+/// Text made safe inside HTML.
+pub(crate) fn escape(s: &str) -> String {
     let mut out = String::with_capacity(s.len());
     for c in s.chars() {
         match c {
@@ -490,6 +491,9 @@ fn identification_html(h: &mut String, rep: &IdentReport, fig: &Figure) {
         let _ = writeln!(h, "</tr>");
     }
     let _ = writeln!(h, "</table>");
+    h.push_str(&super::stiffness_html(
+        rep.stiffness.as_deref().unwrap_or_default(),
+    ));
     figure_html(h, fig);
     let _ = writeln!(
         h,

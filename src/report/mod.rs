@@ -26,6 +26,7 @@ pub mod html;
 pub mod ident_plot;
 pub mod map_plot;
 pub mod move_plot;
+pub mod stiffness;
 pub mod svg;
 
 pub use circle::CircleView;
@@ -33,6 +34,7 @@ pub use html::{generate, ReportRequest};
 pub use ident_plot::identification_svg;
 pub use map_plot::map_svg;
 pub use move_plot::{move_svg, MoveData};
+pub use stiffness::stiffness_html;
 
 /// Reads an input file of the report; a missing file says so in plain words.
 pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>, ReportError> {
