@@ -348,8 +348,13 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
     }
     if !args.quiet {
         print_result(&prep, &result, seconds);
+        let table = args
+            .stiffness_out
+            .as_ref()
+            .map(|p| format!(" (stiffness table {})", p.display()))
+            .unwrap_or_default();
         println!(
-            "\nwrote {} and {}",
+            "\nwrote {} and {}{table}",
             args.out.display(),
             args.report.display()
         );
