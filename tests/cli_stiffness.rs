@@ -173,7 +173,7 @@ fn catalogue_model_table_is_the_hand_calculation() {
     assert!(r.ok, "{}", r.stderr);
     assert!(
         r.stdout
-            .contains("nut 550 mm from the fixed bearing at x = 0.0 mm"),
+            .contains("x: nut 550 mm from the fixed bearing at x = 0.0 mm, 152.1 … 517.2 N/µm"),
         "{}",
         r.stdout
     );

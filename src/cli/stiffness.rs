@@ -75,19 +75,11 @@ pub fn text(machine: &Machine, table: &StiffnessTable) -> String {
         .rows
         .iter()
         .filter_map(|r| r.screw.map(|p| (r.axis, p)))
-        .map(|(axis, p)| {
-            format!(
-                "  {axis}: nut {:.0} mm from the fixed bearing at {axis} = {:.1} mm; value {:.1} … {:.1} N/µm over the stroke",
-                p.nut_bearing_mm,
-                p.axis_position_mm,
-                p.stroke_range_n_per_um[0],
-                p.stroke_range_n_per_um[1]
-            )
-        })
+        .map(|(axis, p)| p.describe(axis))
         .collect();
     if !screws.is_empty() {
-        s.push_str("\nScrew shafts at the reference position (E·A/l₁ follows the nut):\n");
-        s.push_str(&screws.join("\n"));
+        s.push_str("\nScrew shafts at the reference position (E·A/l₁ follows the nut):\n  ");
+        s.push_str(&screws.join("\n  "));
         s.push('\n');
     }
     s

@@ -112,6 +112,20 @@ pub struct ScrewPosition {
     pub stroke_range_n_per_um: [f64; 2],
 }
 
+impl ScrewPosition {
+    /// Where the screw value of `axis` holds, in words: `x: nut 550 mm from the fixed bearing at
+    /// x = 0.0 mm, 152.1 … 517.2 N/µm over the stroke`.
+    pub fn describe(&self, axis: Axis) -> String {
+        format!(
+            "{axis}: nut {:.0} mm from the fixed bearing at {axis} = {:.1} mm, {:.1} … {:.1} N/µm over the stroke",
+            self.nut_bearing_mm,
+            self.axis_position_mm,
+            self.stroke_range_n_per_um[0],
+            self.stroke_range_n_per_um[1]
+        )
+    }
+}
+
 /// One row of the table; in JSON (the identification report's `stiffness`) with the CSV's
 /// column names as keys and `screw` on screw rows.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -40,15 +40,7 @@ pub fn stiffness_html(rows: &[StiffnessRow]) -> String {
     let screws: Vec<String> = rows
         .iter()
         .filter_map(|r| r.screw.map(|p| (r.axis, p)))
-        .map(|(axis, p)| {
-            format!(
-                "{axis}: nut {:.0} mm from the fixed bearing at {axis} = {:.1} mm, {:.1} … {:.1} N/µm over the stroke",
-                p.nut_bearing_mm,
-                p.axis_position_mm,
-                p.stroke_range_n_per_um[0],
-                p.stroke_range_n_per_um[1]
-            )
-        })
+        .map(|(axis, p)| p.describe(axis))
         .collect();
     if !screws.is_empty() {
         let _ = writeln!(
