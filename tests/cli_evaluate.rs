@@ -338,3 +338,197 @@ fn table_and_pooled_output() {
     assert_eq!(pooled["geometric_um_per_mm"].as_object().unwrap().len(), 6);
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// A folder of the demo evaluates at its `rtest.toml` radius (`radius_source`), with the ISO
+/// 230-4 figures of both paths and the cw/ccw pair's G(b); and the measured EIJ that `eij
+/// identify` fits equal `eij evaluate`'s for the same files to 1e-6 µm·s²/m (issue 11: one
+/// normalisation, at the set acceleration).
+#[test]
+fn folders_evaluate_at_the_set_radius_as_identify_does() {
+    let s = Scratch::new("cli-folder-identify");
+    let demo = common::root().join("measurements/demo-vmc/pos-a");
+    std::fs::create_dir_all(s.path("m")).unwrap();
+    for f in ["rtest.toml", "zx_cw_5.csv", "zx_ccw_5.csv", "zx_ccw_8.csv"] {
+        std::fs::copy(demo.join(f), s.path(&format!("m/{f}"))).unwrap();
+    }
+    let r = run(&["evaluate", &s.s("m"), "--json"]);
+    assert!(r.ok, "{}", r.stderr);
+    assert!(r.stderr.is_empty(), "{}", r.stderr);
+    let v: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+    let tests = v["tests"].as_array().unwrap();
+    assert_eq!(tests.len(), 3);
+    for t in tests {
+        assert_eq!(t["radius_source"], "rtest.toml");
+        assert_eq!(t["radius_mm"], 2.0);
+        assert_eq!(t["position_mm"], serde_json::json!([150.0, -100.0, 0.0]));
+        let g = &t["circular_deviation_um"];
+        let (gi, ge) = (
+            g["internal"].as_f64().unwrap(),
+            g["external"].as_f64().unwrap(),
+        );
+        assert!(gi > 0.0 && ge > gi, "{g}");
+        let iso = &t["iso230_4"]["external"];
+        let span = iso["radial_deviation_max_um"].as_f64().unwrap()
+            - iso["radial_deviation_min_um"].as_f64().unwrap();
+        assert!((span - ge).abs() < 1e-9, "F max − F min = G");
+    }
+    let pairs = v["bidirectional"].as_array().unwrap();
+    assert_eq!(pairs.len(), 1, "{pairs:?}");
+    assert!(pairs[0]["files"][0]
+        .as_str()
+        .unwrap()
+        .ends_with("zx_cw_5.csv"));
+
+    let out = common::eij(&[
+        "identify",
+        "--quiet",
+        "--machine",
+        "machines/demo-vmc.toml",
+        "--measured",
+        &s.s("m"),
+        "--param",
+        "z.guideway_normal",
+        "--out",
+        &s.s("id.toml"),
+        "--report",
+        &s.s("id.json"),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(s.path("id.json")).unwrap()).unwrap();
+    let measured = report["tests"].as_array().unwrap();
+    assert_eq!(measured.len(), 3);
+    for (m, t) in measured.iter().zip(tests) {
+        assert_eq!(m["accel_m_s2"], t["accel_m_s2"]);
+        for (p, value) in t["eij_um_s2_per_m"].as_object().unwrap() {
+            let id = m["measured"][p].as_f64().unwrap();
+            assert!(
+                (id - value.as_f64().unwrap()).abs() < 1e-6,
+                "{p}: identify {id} vs evaluate {value}"
+            );
+        }
+    }
+}
+
+/// What real files get wrong is refused with one line naming the file and the column: time in
+/// ms under a seconds header (with the unit that would fit), a dead probe (external columns all
+/// zero), a constant external column, a header eij cannot use (shown with its separator), and
+/// rtest.toml mistakes in `[columns]` and `[[test]]`.
+#[test]
+fn wrong_units_dead_probes_and_bad_layouts_are_refused() {
+    let s = Scratch::new("cli-units-probe");
+    let (t, int, ext) = Synth::new(Plane::Zx, true, 5.0).columns();
+    let t_ms: Vec<f64> = t.iter().map(|v| v * 1e3).collect();
+    let p = s.write("ms.csv", csv_text(&t_ms, &int, &ext));
+    let line = one_line_error(
+        &eij(&["evaluate", &p, "--radius-mm", "2"]),
+        &[
+            &p,
+            "column t_s",
+            "implausible",
+            "ms read as s",
+            "5.000 m/s²",
+        ],
+    );
+    assert!(!line.contains("µm"), "{line}");
+
+    let zeros = [vec![0.0; t.len()], vec![0.0; t.len()], vec![0.0; t.len()]];
+    let p = s.write("dead.csv", csv_text(&t, &int, &zeros));
+    one_line_error(
+        &eij(&["evaluate", &p]),
+        &[
+            &p,
+            "column z_ext_mm",
+            "does not follow the circle",
+            "dead or unconnected",
+        ],
+    );
+    let mut stuck = ext.clone();
+    stuck[1] = vec![0.25; t.len()];
+    let p = s.write("stuck.csv", csv_text(&t, &int, &stuck));
+    one_line_error(
+        &eij(&["evaluate", &p]),
+        &[&p, "column y_ext_mm", "constant (0.25) over the whole file"],
+    );
+
+    let p = s.write(
+        "header.csv",
+        "# probe export\nTime;X;Y;Z;XR;YR;ZR\n0;0;0;2;0;0;2\n",
+    );
+    one_line_error(
+        &eij(&["evaluate", &p]),
+        &[
+            &format!("{p}:2: missing column(s) t_s, x_int_mm"),
+            "header read: 'Time;X;Y;Z;XR;YR;ZR' separated by ';'",
+        ],
+    );
+    // The same file with its columns mapped is no longer refused for its header.
+    s.write(
+        "mapped/rtest.toml",
+        "[columns]\nt_s = \"Time\"\nx_int_mm = \"X\"\ny_int_mm = \"Y\"\nz_int_mm = { name = \"Z\", unit = \"mm\" }\nx_ext_mm = \"XR\"\ny_ext_mm = \"YR\"\nz_ext_mm = \"ZR\"\n",
+    );
+    s.write("mapped/a.csv", std::fs::read(&p).unwrap());
+    let line = one_line_error(&eij(&["evaluate", &s.s("mapped")]), &["a.csv"]);
+    assert!(!line.contains("missing column"), "{line}");
+
+    let cases = [
+        (
+            "[columns]\nt_sec = \"Time\"\n",
+            "rtest.toml: columns.t_sec: not a contract column (expected one of t_s, x_int_mm",
+        ),
+        (
+            "[columns]\nt_s = { name = \"Time\", unit = \"mm\" }\n",
+            "rtest.toml: columns.t_s.unit: 'mm' is no unit of this column (expected s, ms or us)",
+        ),
+        (
+            "[[test]]\nfile = \"nope.csv\"\n",
+            "rtest.toml: [[test]] #1 file:",
+        ),
+        (
+            "[[test]]\nfile = \"a.csv\"\ninternal = \"a.csv\"\n",
+            "rtest.toml: [[test]] #1 file: give either file or internal and external, not both",
+        ),
+        (
+            "[[test]]\ninternal = \"a.csv\"\n",
+            "rtest.toml: [[test]] #1 external: missing: internal needs its external file",
+        ),
+        (
+            "[[test]]\nfile = \"a.csv\"\ndirection = \"left\"\n",
+            "rtest.toml: [[test]] #1 direction: unknown direction 'left'",
+        ),
+    ];
+    for (toml, needle) in cases {
+        s.write("bad/rtest.toml", toml);
+        s.write("bad/a.csv", csv_text(&t, &int, &ext));
+        one_line_error(&eij(&["evaluate", &s.s("bad")]), &[needle]);
+    }
+}
+
+/// `[[test]]` conditions reach the output: a note, and warnings where the stated direction or
+/// feed disagree with the data; no radius anywhere is said as `internal-mean`.
+#[test]
+fn test_entries_state_conditions_that_are_checked() {
+    let s = Scratch::new("cli-test-entries");
+    // The steady speed: r ω = 2 mm · 50 rad/s = 6000 mm/min.
+    s.write(
+        "m/rtest.toml",
+        "radius_mm = 2.0\n[[test]]\nfile = \"zx.csv\"\ndirection = \"cw\"\nfeed_mm_min = 9000\nnote = \"warm\"\n",
+    );
+    Synth::new(Plane::Zx, true, 5.0).write_csv(&s.path("m/zx.csv"));
+    let r = run(&["evaluate", &s.s("m"), "--json"]);
+    assert!(r.ok, "{}", r.stderr);
+    let v: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+    let t = &v["tests"][0];
+    assert_eq!(t["note"], "warm");
+    let w = t["warnings"].to_string();
+    assert!(w.contains("rtest.toml says cw, the data turn ccw"), "{w}");
+    assert!(
+        w.contains("programmed feed 9000 mm/min, the steady circle runs at 6000.0"),
+        "{w}"
+    );
+    assert_eq!(r.stderr.lines().count(), 2, "{}", r.stderr);
+}

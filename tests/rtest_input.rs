@@ -158,7 +158,15 @@ fn eij_table_round_trips_and_is_strict() {
         ),
         (
             format!("{head},std_err_um_s2_per_m\nzx,ccw,4.5,EXZ,1,-2\n"),
-            ":2: column std_err_um_s2_per_m: standard error -2 must not be negative",
+            ":2: column std_err_um_s2_per_m: standard error -2 must be positive",
+        ),
+        (
+            format!("{head},std_err_um_s2_per_m\nzx,ccw,4.5,EXZ,1,0\n"),
+            ":2: column std_err_um_s2_per_m: standard error 0 must be positive (a zero would give the value infinite weight",
+        ),
+        (
+            format!("{head}\nzx,ccw,4.5,EXZ,-1.55\nzx,cw,4.5,EXZ,-1.5\nzx,ccw,4.5,EXZ,-1.6\n"),
+            ":4: column parameter: EXZ of zx ccw at 4.5 m/s² given twice (first on line 2)",
         ),
         (
             format!("{head},note\nzx,ccw,4.5,EXZ,1,a\n"),
@@ -182,6 +190,17 @@ fn eij_table_round_trips_and_is_strict() {
     )
     .unwrap();
     assert_eq!(table::read(&p).unwrap()[0].std_err, None);
+    // A spreadsheet's `;` table with decimal commas and a comment reads as the `,` one.
+    std::fs::write(
+        &p,
+        "# typed from the paper\nplane;direction;accel_m_s2;parameter;value_um_s2_per_m;std_err_um_s2_per_m\nzx;ccw;4,5;EXZ;-1,55;0,05\n",
+    )
+    .unwrap();
+    let row = &table::read(&p).unwrap()[0];
+    assert_eq!(
+        (row.accel_m_s2, row.value, row.std_err),
+        (4.5, -1.55, Some(0.05))
+    );
     let _ = std::fs::remove_dir_all(&d);
 }
 

@@ -100,6 +100,8 @@ pub struct VerifyArgs {
 struct Prepared {
     problem: Problem,
     provenance: Provenance,
+    /// What reading the measured tests found (conditions, clocks), for the report's warnings.
+    warnings: Vec<String>,
 }
 
 fn prepare(
@@ -125,7 +127,7 @@ fn prepare(
             .map(|n| Parameter::parse(n, &machine))
             .collect::<Result<Vec<_>, _>>()?
     };
-    let tests = measured::load(measured_paths, &mopts)?;
+    let (tests, warnings) = measured::load_with_warnings(measured_paths, &mopts)?;
     let problem =
         Problem::new(machine, params, tests, settings).map_err(super::advice::identify)?;
     let provenance = Provenance::now(
@@ -138,6 +140,7 @@ fn prepare(
     Ok(Prepared {
         problem,
         provenance,
+        warnings,
     })
 }
 
@@ -170,10 +173,9 @@ fn run_identification(prep: &Prepared, quiet: bool) -> anyhow::Result<(IdentResu
     if let Some(b) = bar {
         b.finish_and_clear();
     }
-    Ok((
-        result.map_err(super::advice::identify)?,
-        start.elapsed().as_secs_f64(),
-    ))
+    let mut result = result.map_err(super::advice::identify)?;
+    result.warnings.splice(0..0, prep.warnings.iter().cloned());
+    Ok((result, start.elapsed().as_secs_f64()))
 }
 
 fn print_result(prep: &Prepared, result: &IdentResult, seconds: f64) {

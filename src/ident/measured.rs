@@ -4,110 +4,120 @@
 pub use super::settings::MeasuredOptions;
 use super::{IdentError, TestCase};
 use crate::predict::CircleTest;
-use crate::rtest::conditions::TestConditions;
-use crate::rtest::{self, table, CircleSeries, EvalOptions};
+use crate::rtest::conditions::Recording;
+use crate::rtest::inputs::{expand_tests, TestInput};
+use crate::rtest::suite::{evaluate_tests, SuiteOptions};
+use crate::rtest::table;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
-
-/// Whether a CSV file is an EIJ table (has a `parameter` column) rather than a time series.
-fn is_table(path: &Path) -> bool {
-    std::fs::read(path)
-        .ok()
-        .and_then(|b| {
-            let first = b.split(|&c| c == b'\n').next()?.to_vec();
-            Some(
-                String::from_utf8_lossy(&first)
-                    .split(',')
-                    .any(|c| c.trim() == "parameter"),
-            )
-        })
-        .unwrap_or(false)
-}
+use std::path::PathBuf;
 
 /// Expands folders (their `*.csv`, sub-folders included, sorted) and keeps files.
 pub fn expand(paths: &[PathBuf]) -> Result<Vec<PathBuf>, IdentError> {
     Ok(crate::rtest::conditions::expand_inputs(paths)?)
 }
 
-/// Reads every path into test cases (R-Test series are evaluated; tables grouped by plane,
-/// direction and acceleration). Folders are read with their sub-folders; the optional
-/// `rtest.toml` beside the files states their set radius and circle-centre position.
+/// Reads every path into test cases: R-Test series (single files and two-system recordings
+/// with their `rtest.toml` conditions) are evaluated as `eij evaluate` does
+/// ([`crate::rtest::suite::evaluate_tests`], so that the measured EIJ are evaluate's), the set
+/// radius from `rtest.toml`, else `opts.radius_mm`; EIJ tables are grouped by plane, direction
+/// and acceleration. Folders are read with their sub-folders.
 pub fn load(paths: &[PathBuf], opts: &MeasuredOptions) -> Result<Vec<TestCase>, IdentError> {
-    // The rtest.toml of a file's own folder states the conditions of that file.
-    let mut tests = Vec::new();
-    for f in expand(paths)? {
-        let conditions = TestConditions::of_file(&f)?;
-        tests.extend(load_files(std::slice::from_ref(&f), opts, &conditions)?);
-    }
-    Ok(tests)
+    Ok(load_with_warnings(paths, opts)?.0)
 }
 
-fn load_files(
-    files: &[PathBuf],
+/// As [`load`], with what the evaluation says about the tests' conditions and clocks (a
+/// direction or feed at odds with the data, a clock offset not separable from cross-talk),
+/// each naming its test or clock: for the identification's warnings.
+pub fn load_with_warnings(
+    paths: &[PathBuf],
     opts: &MeasuredOptions,
-    cond: &TestConditions,
-) -> Result<Vec<TestCase>, IdentError> {
-    let radius_mm = cond.radius_mm.unwrap_or(opts.radius_mm);
-    let position_m = cond
-        .position_mm
-        .as_ref()
-        .map(|p| p.iter().map(|v| v * 1e-3).collect::<Vec<f64>>());
+) -> Result<(Vec<TestCase>, Vec<String>), IdentError> {
+    let inputs = expand_tests(paths)?;
+    let (tables, series): (Vec<&TestInput>, Vec<&TestInput>) = inputs
+        .iter()
+        .partition(|t| matches!(&t.recording, Recording::Single(f) if table::looks_like_table(f)));
+    let series: Vec<TestInput> = series.into_iter().cloned().collect();
+    let suite = evaluate_tests(
+        &series,
+        &SuiteOptions {
+            fallback_radius_mm: Some(opts.radius_mm),
+            ..Default::default()
+        },
+    )?;
+    let mut warnings = suite.warnings;
+    warnings.extend(
+        suite
+            .tests
+            .iter()
+            .flat_map(|t| t.notes.iter().map(|n| format!("{}: {n}", t.input.name()))),
+    );
+    let mut evaluated = suite.tests.into_iter();
     let mut tests = Vec::new();
-    for f in files {
-        let name = f.display().to_string();
-        let err = IdentError::Rtest;
-        if is_table(f) {
-            let rows = table::read(f).map_err(err)?;
-            let mut groups: BTreeMap<(String, String, u64), TestCase> = BTreeMap::new();
-            for row in rows {
-                let key = (
-                    row.plane.to_string(),
-                    row.direction.to_string(),
-                    row.accel_m_s2.to_bits(),
-                );
-                let case = groups.entry(key).or_insert_with(|| TestCase {
-                    source: format!(
-                        "{name} ({} {} {} m/s²)",
-                        row.plane, row.direction, row.accel_m_s2
-                    ),
-                    circle: CircleTest {
-                        plane: row.plane,
-                        direction: row.direction,
-                        radius_mm,
-                        accel_m_s2: row.accel_m_s2,
-                        position_m: position_m.clone(),
-                    },
-                    measured: BTreeMap::new(),
-                });
-                case.measured.insert(
-                    row.parameter,
-                    (row.value, row.std_err.unwrap_or(opts.table_std_err)),
-                );
-            }
-            tests.extend(groups.into_values());
-        } else {
-            let series = CircleSeries::read_csv(f).map_err(err)?;
-            let eval = EvalOptions {
-                plane: None,
-                radius_mm: Some(radius_mm),
-            };
-            let result = rtest::evaluate(&series, &eval).map_err(err)?;
-            tests.push(TestCase {
-                source: name.clone(),
-                circle: CircleTest {
-                    plane: result.plane,
-                    direction: result.direction,
-                    radius_mm: result.radius_mm,
-                    accel_m_s2: result.accel_m_s2,
-                    position_m: position_m.clone(),
-                },
-                measured: result
-                    .eij
-                    .iter()
-                    .map(|(p, v)| (*p, (*v, result.std_err[p])))
-                    .collect(),
-            });
+    for input in &inputs {
+        let position_m = input
+            .position_mm
+            .as_ref()
+            .map(|p| p.iter().map(|v| v * 1e-3).collect::<Vec<f64>>());
+        if tables.iter().any(|t| std::ptr::eq(*t, input)) {
+            let radius_mm = input.radius_mm.unwrap_or(opts.radius_mm);
+            tests.extend(table_tests(input, radius_mm, position_m, opts)?);
+            continue;
         }
+        let Some(e) = evaluated.next() else { break };
+        let result = e.result;
+        tests.push(TestCase {
+            source: input.name(),
+            circle: CircleTest {
+                plane: result.plane,
+                direction: result.direction,
+                radius_mm: result.radius_mm,
+                accel_m_s2: result.accel_m_s2,
+                position_m,
+            },
+            measured: result
+                .eij
+                .iter()
+                .map(|(p, v)| (*p, (*v, result.std_err[p])))
+                .collect(),
+        });
     }
-    Ok(tests)
+    Ok((tests, warnings))
+}
+
+/// The tests of an EIJ table, one per plane, direction and acceleration.
+fn table_tests(
+    input: &TestInput,
+    radius_mm: f64,
+    position_m: Option<Vec<f64>>,
+    opts: &MeasuredOptions,
+) -> Result<Vec<TestCase>, IdentError> {
+    let name = input.name();
+    let rows = table::read(input.primary_file())?;
+    let mut groups: BTreeMap<(String, String, u64), TestCase> = BTreeMap::new();
+    for row in rows {
+        let key = (
+            row.plane.to_string(),
+            row.direction.to_string(),
+            row.accel_m_s2.to_bits(),
+        );
+        let case = groups.entry(key).or_insert_with(|| TestCase {
+            source: format!(
+                "{name} ({} {} {} m/s²)",
+                row.plane, row.direction, row.accel_m_s2
+            ),
+            circle: CircleTest {
+                plane: row.plane,
+                direction: row.direction,
+                radius_mm,
+                accel_m_s2: row.accel_m_s2,
+                position_m: position_m.clone(),
+            },
+            measured: BTreeMap::new(),
+        });
+        case.measured.insert(
+            row.parameter,
+            (row.value, row.std_err.unwrap_or(opts.table_std_err)),
+        );
+    }
+    Ok(groups.into_values().collect())
 }

@@ -17,8 +17,8 @@ use super::ident_plot::test_label;
 use super::{identification_svg, move_svg, short, CircleView, Conditions, MoveData, ReportError};
 use crate::axes::Plane;
 use crate::ident::report::IdentReport;
-use crate::rtest::conditions::TestConditions;
-use crate::rtest::{self, CircleResult, CircleSeries, EvalOptions};
+use crate::rtest::suite::EvaluatedTest;
+use crate::rtest::{CircleResult, EvalOptions};
 
 /// The report page's file name.
 pub const REPORT_FILE: &str = "report.html";
@@ -124,24 +124,26 @@ pub fn fmt_eij(v: f64) -> String {
     }
 }
 
-fn evaluate_file(path: &Path, index: usize) -> Result<CircleEntry, ReportError> {
-    let folder = TestConditions::of_file(path)?;
+/// The figures of an evaluated test (evaluated as `eij evaluate` does, see
+/// [`crate::rtest::suite`]).
+fn circle_entry(t: EvaluatedTest, index: usize) -> Result<CircleEntry, ReportError> {
+    let path = t.input.primary_file().to_path_buf();
+    let path = path.as_path();
     let opts = EvalOptions {
-        plane: None,
-        radius_mm: folder.radius_mm,
+        plane: Some(t.result.plane),
+        radius_mm: Some(t.result.radius_mm),
     };
-    let series = CircleSeries::read_csv(path)?;
-    let result = rtest::evaluate(&series, &opts)?;
-    let view = CircleView::new(&series, &opts)?;
+    let result = t.result;
+    let view = CircleView::new(&t.series, &opts)?;
     let conditions = Conditions {
-        source: path.display().to_string(),
+        source: t.input.name(),
         machine: None,
-        position_mm: folder.position_mm,
+        position_mm: t.input.position_mm.clone(),
     };
     let s = stem(path);
     let caption = format!(
         "{}: plane {}, {}, r = {} mm, {} m/s², {} Hz",
-        path.display(),
+        conditions.source,
         result.plane,
         result.direction,
         short(result.radius_mm, 4),
@@ -235,10 +237,13 @@ pub fn generate(req: &ReportRequest) -> Result<Vec<PathBuf>, ReportError> {
         }
     }
     let files = expand_measured(&req.measured)?;
-    let circles = files
-        .iter()
+    let tests = crate::rtest::inputs::expand_tests(&req.measured)?;
+    let suite = crate::rtest::suite::evaluate_tests(&tests, &Default::default())?;
+    let circles = suite
+        .tests
+        .into_iter()
         .enumerate()
-        .map(|(i, f)| evaluate_file(f, i + 1))
+        .map(|(i, t)| circle_entry(t, i + 1))
         .collect::<Result<Vec<_>, _>>()?;
     let ident = req
         .identify_report

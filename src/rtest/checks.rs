@@ -104,7 +104,7 @@ pub(super) fn check_time_scale(
     .map_or(String::new(), |(f, what)| {
         let w = omega * f;
         format!(
-            "; the times look {what}: then {:.3} m/s² at {:.3} Hz. State the unit in rtest.toml              [columns], e.g. t_s = {{ unit = \"ms\" }}",
+            "; the times look {what}: then {:.3} m/s² at {:.3} Hz. State the unit in rtest.toml [columns], e.g. t_s = {{ unit = \"ms\" }}",
             radius_mm * 1e-3 * w * w,
             w.abs() / TAU
         )

@@ -292,6 +292,19 @@ pub fn separator_of(line: &[u8]) -> u8 {
     best.1
 }
 
+/// The first line that is no comment and not blank (a byte-order mark dropped).
+pub fn header_line(bytes: &[u8]) -> Option<&[u8]> {
+    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    lines(bytes)
+        .map(|(_, _, l)| l)
+        .find(|l| !is_comment_or_blank(l))
+}
+
+/// The separator of a file's header line (see [`separator_of`]).
+pub fn header_separator(bytes: &[u8]) -> u8 {
+    header_line(bytes).map_or(b',', separator_of)
+}
+
 /// A header cell as compared with column names: trimmed, quotes removed, lower case.
 fn normalise_name(cell: &str) -> String {
     let t = cell.trim();

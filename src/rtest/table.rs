@@ -12,6 +12,21 @@ use super::series::{
 use super::CircleResult;
 use crate::axes::{Direction, Eij, Plane};
 
+/// Whether a file looks like an EIJ table (its header has a `parameter` column) rather than a
+/// time series.
+pub fn looks_like_table(path: &Path) -> bool {
+    std::fs::read(path)
+        .map(|b| {
+            let sep = super::layout::header_separator(&b);
+            super::layout::header_line(&b).is_some_and(|line| {
+                String::from_utf8_lossy(line)
+                    .split(sep as char)
+                    .any(|c| c.trim().trim_matches('"') == "parameter")
+            })
+        })
+        .unwrap_or(false)
+}
+
 /// Required columns, in the order written.
 pub const COLUMNS: [&str; 5] = [
     "plane",
@@ -60,7 +75,9 @@ pub fn rows_from_result(result: &CircleResult) -> Vec<EijRow> {
 /// Reads an EIJ table strictly: header with the five required columns (any order), the
 /// optional standard-error column, nothing else; every row a known plane and direction, a
 /// positive finite acceleration, a parameter of that plane, a finite value and, where given,
-/// a finite non-negative standard error (an empty cell means unknown). At least one row.
+/// a finite positive standard error (an empty cell means unknown); no parameter of a test
+/// (plane, direction, acceleration) twice. At least one row. Separator `,`, `;` or tab (decimal
+/// comma where `,` is not the separator) and `#` comment lines are recognised.
 pub fn read(path: impl AsRef<Path>) -> Result<Vec<EijRow>, RtestError> {
     let path = path.as_ref();
     let bytes = read_file(path)?;
@@ -72,10 +89,21 @@ pub fn read(path: impl AsRef<Path>) -> Result<Vec<EijRow>, RtestError> {
 pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<Vec<EijRow>, RtestError> {
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     let name = name.to_string();
+    let separator = super::layout::header_separator(bytes);
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(false)
+        .delimiter(separator)
+        .comment(Some(b'#'))
         .trim(csv::Trim::All)
         .from_reader(bytes);
+    // A decimal comma where `,` is not the separator.
+    let number = |text: &str, line: u64, column: &str| {
+        if separator != b',' && text.contains(',') && !text.contains('.') {
+            parse_number(&text.replace(',', "."), &name, line, column)
+        } else {
+            parse_number(text, &name, line, column)
+        }
+    };
     let mut counter = LineCounter::new(bytes);
     let mut records = reader.records();
     let expected = || format!("{},{}", COLUMNS.join(","), STD_ERR_COLUMN);
@@ -107,6 +135,7 @@ pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<Vec<EijRow>, RtestError> {
     })?;
     require_columns(&index[..COLUMNS.len()], &COLUMNS, &header_at)?;
     let mut rows = Vec::new();
+    let mut seen = std::collections::HashMap::new();
     for record in records {
         let record = record.map_err(|e| csv_error(&name, &mut counter, e))?;
         let line = counter.line_of_record(&record);
@@ -122,7 +151,7 @@ pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<Vec<EijRow>, RtestError> {
         };
         let plane: Plane = cell(0).parse().map_err(|m| bad(0, m))?;
         let direction: Direction = cell(1).parse().map_err(|m| bad(1, m))?;
-        let accel_m_s2 = parse_number(raw(2), &name, line, COLUMNS[2])?;
+        let accel_m_s2 = number(raw(2), line, COLUMNS[2])?;
         if accel_m_s2 <= 0.0 {
             return Err(bad(
                 2,
@@ -136,24 +165,37 @@ pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<Vec<EijRow>, RtestError> {
                 format!("{parameter} is not a parameter of plane {plane}"),
             ));
         }
-        let value = parse_number(raw(4), &name, line, COLUMNS[4])?;
+        let value = number(raw(4), line, COLUMNS[4])?;
         let std_err = match index[5] {
             usize::MAX => None,
             i => match record.get(i).unwrap_or("") {
                 "" => None,
                 text => {
-                    let s = parse_number(text, &name, line, STD_ERR_COLUMN)?;
-                    if s < 0.0 {
+                    let s = number(text, line, STD_ERR_COLUMN)?;
+                    if s <= 0.0 {
                         return Err(RtestError::BadValue {
                             at: at(),
                             column: STD_ERR_COLUMN.into(),
-                            message: format!("standard error {s} must not be negative"),
+                            message: format!(
+                                "standard error {s} must be positive (a zero would give the \
+                                 value infinite weight; leave the cell empty when unknown)"
+                            ),
                         });
                     }
                     Some(s)
                 }
             },
         };
+        let key = (plane, direction, accel_m_s2.to_bits(), parameter);
+        if let Some(first) = seen.insert(key, line) {
+            return Err(bad(
+                3,
+                format!(
+                    "{parameter} of {plane} {direction} at {accel_m_s2} m/s² given twice \
+                     (first on line {first})"
+                ),
+            ));
+        }
         rows.push(EijRow {
             plane,
             direction,

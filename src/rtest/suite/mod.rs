@@ -70,6 +70,10 @@ pub struct EvaluatedTest {
     pub radius_source: RadiusSource,
     /// The clock offset applied (two-system tests, and single-file tests corrected by it).
     pub time_offset: Option<TimeOffset>,
+    /// What the test's conditions and clock add to the evaluation's own warnings (also in
+    /// `result.warnings`): a missing set radius, a direction or feed that disagree with the
+    /// data, a clock offset not separable from cross-talk.
+    pub notes: Vec<String>,
 }
 
 /// A cw/ccw pair with its ISO 230-4 bi-directional circular deviations.
@@ -175,15 +179,13 @@ pub fn evaluate_tests(inputs: &[TestInput], opts: &SuiteOptions) -> Result<Suite
     for ((input, p), offset) in inputs.iter().zip(prepared).zip(offsets) {
         let series = series_at(input, &p.data, offset.as_ref().map(|o| o.offset_ms * 1e-3))?;
         let mut result = evaluate(&series, &p.opts)?;
-        result
-            .warnings
-            .extend(condition_warnings(input, &result, p.source));
+        let mut notes = condition_warnings(input, &result, p.source);
         if let Some(o) = offset
             .as_ref()
             .filter(|o| o.source == OffsetSource::Trajectory)
         {
             let (a, b) = result.plane.axes();
-            result.warnings.push(format!(
+            notes.push(format!(
                 "clock offset {:.4} ms from the trajectories only (its clock's tests cannot \
                  separate it from cross-talk): {} − {} is not measured",
                 o.offset_ms,
@@ -191,12 +193,14 @@ pub fn evaluate_tests(inputs: &[TestInput], opts: &SuiteOptions) -> Result<Suite
                 Eij::new(b, a)
             ));
         }
+        result.warnings.extend(notes.iter().cloned());
         tests.push(EvaluatedTest {
             input: input.clone(),
             series,
             result,
             radius_source: p.source,
             time_offset: offset,
+            notes,
         });
     }
     let bidirectional = pairs(&tests);
