@@ -99,9 +99,7 @@ impl CircleTest {
 }
 
 /// How a test is simulated.
-#[derive(
-    Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum,
-)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum SolverKind {
     /// Harmonic steady state (one complex solve per test; default).

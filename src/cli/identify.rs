@@ -5,7 +5,7 @@ use anyhow::{bail, Context};
 use eij::ident::config::{IdentConfig, KnownGood};
 use eij::ident::measured::{self, MeasuredOptions};
 use eij::ident::report::{self, Provenance};
-use eij::ident::{identify, IdentResult, Method, Parameter, Problem, Settings};
+use eij::ident::{identify, IdentResult, Method, Parameter, Problem, Settings, SolverKind};
 use eij::machine::Machine;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
@@ -57,11 +57,11 @@ pub struct IdentifyArgs {
     params: Vec<String>,
     /// Optimiser.
     #[arg(long, value_enum)]
-    method: Option<Method>,
+    method: Option<MethodArg>,
     /// How the tests are simulated during the optimisation (the result is confirmed in the time
     /// domain either way).
     #[arg(long, value_enum)]
-    solver: Option<eij::ident::SolverKind>,
+    solver: Option<SolverArg>,
     /// Iteration limit.
     #[arg(long)]
     max_iters: Option<u64>,
@@ -88,6 +88,42 @@ pub struct IdentifyArgs {
     /// No progress bar and no tables, only errors.
     #[arg(long)]
     quiet: bool,
+}
+
+/// `--method`: the library's [`Method`] as the command line spells it.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+enum MethodArg {
+    /// Levenberg–Marquardt on the weighted residuals (default).
+    Lm,
+    /// Nelder–Mead on the weighted sum of squares (robust fallback, slower).
+    NelderMead,
+}
+
+impl From<MethodArg> for Method {
+    fn from(m: MethodArg) -> Self {
+        match m {
+            MethodArg::Lm => Method::Lm,
+            MethodArg::NelderMead => Method::NelderMead,
+        }
+    }
+}
+
+/// `--solver`: the library's [`SolverKind`] as the command line spells it.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+enum SolverArg {
+    /// Harmonic steady state (one complex solve per test; default).
+    Harmonic,
+    /// Time-domain simulation with ramps, exactly like `eij simulate circle`.
+    Time,
+}
+
+impl From<SolverArg> for SolverKind {
+    fn from(s: SolverArg) -> Self {
+        match s {
+            SolverArg::Harmonic => SolverKind::Harmonic,
+            SolverArg::Time => SolverKind::Time,
+        }
+    }
 }
 
 /// Arguments of `eij verify`.
@@ -282,10 +318,10 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
         None => IdentConfig::default(),
     };
     if let Some(m) = args.method {
-        config.method = Some(m);
+        config.method = Some(m.into());
     }
     if let Some(m) = args.solver {
-        config.solver = Some(m);
+        config.solver = Some(m.into());
     }
     if let Some(m) = args.max_iters {
         config.max_iters = Some(m);

@@ -20,6 +20,7 @@
 //! [`identify`], which runs them in order; [`stiffness`] gives the identified stiffness set as a
 //! table.
 
+mod builder;
 pub mod config;
 mod error;
 pub mod lm;
@@ -32,6 +33,7 @@ pub mod stiffness;
 pub mod uncertainty;
 
 pub use crate::predict::{EijMap, SolverKind};
+pub use builder::Identification;
 pub use error::IdentError;
 pub use parameters::{Parameter, ParameterKind};
 pub use problem::{Problem, TestCase};

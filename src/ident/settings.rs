@@ -5,9 +5,7 @@
 use crate::predict::SimSettings;
 
 /// Which optimiser.
-#[derive(
-    Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum,
-)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Method {
     /// Levenberg–Marquardt on the weighted residuals (default).
