@@ -4,6 +4,7 @@
 #![allow(dead_code)]
 
 pub mod mutation;
+pub mod random_machine;
 pub mod synth;
 
 use eij::machine::Machine;
