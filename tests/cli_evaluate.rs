@@ -341,8 +341,9 @@ fn table_and_pooled_output() {
 
 /// A folder of the demo evaluates at its `rtest.toml` radius (`radius_source`), with the ISO
 /// 230-4 figures of both paths and the cw/ccw pair's G(b); and the measured EIJ that `eij
-/// identify` fits equal `eij evaluate`'s for the same files to 1e-6 µm·s²/m (issue 11: one
-/// normalisation, at the set acceleration).
+/// identify` fits equal `eij evaluate`'s for the same files to 1e-6 µm·s²/m, its report naming
+/// each test's position and frequency as evaluate does (issue 11: one normalisation, at the
+/// set acceleration).
 #[test]
 fn folders_evaluate_at_the_set_radius_as_identify_does() {
     let s = Scratch::new("cli-folder-identify");
@@ -404,6 +405,12 @@ fn folders_evaluate_at_the_set_radius_as_identify_does() {
     assert_eq!(measured.len(), 3);
     for (m, t) in measured.iter().zip(tests) {
         assert_eq!(m["accel_m_s2"], t["accel_m_s2"]);
+        assert_eq!(m["position_mm"], t["position_mm"]);
+        let (fi, fe) = (
+            m["freq_hz"].as_f64().unwrap(),
+            t["freq_hz"].as_f64().unwrap(),
+        );
+        assert!((fi - fe).abs() < 1e-9 * fe, "freq_hz {fi} vs {fe}");
         for (p, value) in t["eij_um_s2_per_m"].as_object().unwrap() {
             let id = m["measured"][p].as_f64().unwrap();
             assert!(
