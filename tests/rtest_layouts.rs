@@ -23,6 +23,14 @@ use eij::rtest::suite::{evaluate_tests, OffsetSource, Suite, SuiteOptions};
 use eij::sim::setpoint::Circle;
 use eij::sim::{output, simulate};
 
+/// cw and ccw at 2 and 8 m/s²: tests that separate a clock offset from cross-talk.
+const BOTH_DIRECTIONS_TWO_ACCELERATIONS: [(Direction, f64); 4] = [
+    (Direction::Cw, 2.0),
+    (Direction::Ccw, 2.0),
+    (Direction::Cw, 8.0),
+    (Direction::Ccw, 8.0),
+];
+
 /// Columns t, internal x/y/z, external x/y/z (s, mm).
 #[derive(Clone)]
 struct Cols {
@@ -226,15 +234,7 @@ fn two_system_recordings_give_the_single_file_eij_and_the_clock_offset() {
     let mut toml = String::from("radius_mm = 2.0\n");
     let mut noisy_toml = toml.clone();
     let mut clock = 1234.5;
-    for (k, (dir, accel)) in [
-        (Direction::Cw, 2.0),
-        (Direction::Ccw, 2.0),
-        (Direction::Cw, 8.0),
-        (Direction::Ccw, 8.0),
-    ]
-    .into_iter()
-    .enumerate()
-    {
+    for (k, (dir, accel)) in BOTH_DIRECTIONS_TWO_ACCELERATIONS.into_iter().enumerate() {
         let c = simulated(dir, accel, 5000.0, 0.0, 0);
         let name = format!("{dir}_{accel}");
         d.write(&format!("single/{name}.csv"), c.every(0, 5).csv());
@@ -408,15 +408,7 @@ fn an_offset_the_tests_cannot_separate_is_said_so() {
 #[test]
 fn a_lagging_logger_is_found_and_corrected() {
     let d = Scratch::new("lag");
-    for (k, (dir, accel)) in [
-        (Direction::Cw, 2.0),
-        (Direction::Ccw, 2.0),
-        (Direction::Cw, 8.0),
-        (Direction::Ccw, 8.0),
-    ]
-    .into_iter()
-    .enumerate()
-    {
+    for (dir, accel) in BOTH_DIRECTIONS_TWO_ACCELERATIONS {
         let c = simulated(dir, accel, 5000.0, 0.0, 0);
         // 1 kHz rows; the external value of 0.2 ms (one 5 kHz sample) earlier.
         let mut lagged = c.every(5, 5);

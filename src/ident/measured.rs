@@ -13,7 +13,7 @@ use std::path::PathBuf;
 
 /// Expands folders (their `*.csv`, sub-folders included, sorted) and keeps files.
 pub fn expand(paths: &[PathBuf]) -> Result<Vec<PathBuf>, IdentError> {
-    Ok(crate::rtest::conditions::expand_inputs(paths)?)
+    Ok(crate::rtest::inputs::expand_inputs(paths)?)
 }
 
 /// Reads every path into test cases: R-Test series (single files and two-system recordings

@@ -59,9 +59,9 @@ struct CircleEntry {
     conditions: Conditions,
 }
 
-/// Expands files and folders (see [`crate::rtest::conditions::expand_inputs`]).
+/// Expands files and folders (see [`crate::rtest::inputs::expand_inputs`]).
 pub fn expand_measured(paths: &[PathBuf]) -> Result<Vec<PathBuf>, ReportError> {
-    Ok(crate::rtest::conditions::expand_inputs(paths)?)
+    Ok(crate::rtest::inputs::expand_inputs(paths)?)
 }
 
 /// `folder/name` of a path: the name alone is ambiguous when several folders (test positions)

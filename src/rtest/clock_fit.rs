@@ -24,7 +24,7 @@ use std::collections::BTreeMap;
 
 use nalgebra::{DMatrix, Matrix2};
 
-use super::fit::lstsq;
+use super::fit::{joint_lstsq, lstsq};
 use super::normalise::Normalised;
 use crate::axes::{Eij, Plane};
 
@@ -93,15 +93,7 @@ fn distinct(values: &[f64]) -> usize {
 
 /// Per-test joint fit [ä_a, ä_b, 1] with the covariance of the two EIJ columns.
 fn per_test(norm: &Normalised, group: usize) -> Option<PerTest> {
-    let n = norm.samples();
-    let [acc_a, acc_b] = &norm.acc_m_s2;
-    let x = DMatrix::from_fn(n, 3, |i, j| match j {
-        0 => acc_a[i],
-        1 => acc_b[i],
-        _ => 1.0,
-    });
-    let y = DMatrix::from_fn(n, 3, |i, j| norm.dev_um[j][i]);
-    let fit = lstsq(x, y)?;
+    let fit = joint_lstsq(norm)?;
     let c = fit.cov_unscaled.view((0, 0), (2, 2)).into_owned();
     let c = Matrix2::new(c[(0, 0)], c[(0, 1)], c[(1, 0)], c[(1, 1)]);
     let mut e = [[0.0; 2]; 3];

@@ -83,14 +83,7 @@ pub struct JointFit {
 /// s² = rᵀr/(n − 3), cov = s² (XᵀX)⁻¹.
 pub fn joint(norm: &Normalised) -> Option<JointFit> {
     let n = norm.samples();
-    let [acc_a, acc_b] = &norm.acc_m_s2;
-    let x = DMatrix::from_fn(n, 3, |i, j| match j {
-        0 => acc_a[i],
-        1 => acc_b[i],
-        _ => 1.0,
-    });
-    let y = DMatrix::from_fn(n, 3, |i, j| norm.dev_um[j][i]);
-    let fit = lstsq(x, y)?;
+    let fit = joint_lstsq(norm)?;
     let (a, b) = norm.plane.axes();
     let components = [a, b, norm.plane.normal()];
     let mut eij = BTreeMap::new();
@@ -110,6 +103,20 @@ pub fn joint(norm: &Normalised) -> Option<JointFit> {
         offsets_um,
         rms_residual_um,
     })
+}
+
+/// The least-squares problem of [`joint`]: [ä_a, ä_b, 1] against [d_a, d_b, d_k] (rows of
+/// the coefficients: E_·a, E_·b, offset; columns: components a, b, k).
+pub fn joint_lstsq(norm: &Normalised) -> Option<Lstsq> {
+    let n = norm.samples();
+    let [acc_a, acc_b] = &norm.acc_m_s2;
+    let x = DMatrix::from_fn(n, 3, |i, j| match j {
+        0 => acc_a[i],
+        1 => acc_b[i],
+        _ => 1.0,
+    });
+    let y = DMatrix::from_fn(n, 3, |i, j| norm.dev_um[j][i]);
+    lstsq(x, y)
 }
 
 /// The paper's route to cross-talk: a least-squares plane d_k = p_a a_set + p_b b_set + c

@@ -247,3 +247,16 @@ pub fn expand_tests(paths: &[PathBuf]) -> Result<Vec<TestInput>, RtestError> {
     }
     Ok(tests)
 }
+
+/// The files of the measured inputs of a command (every file of every test of
+/// [`expand_tests`], in test order; both files of a two-system test): for the provenance of
+/// outputs and for refusing to write over an input.
+pub fn expand_inputs(paths: &[PathBuf]) -> Result<Vec<PathBuf>, RtestError> {
+    Ok(expand_tests(paths)?
+        .into_iter()
+        .flat_map(|t| match t.recording {
+            Recording::Single(f) => vec![f],
+            Recording::Split { internal, external } => vec![internal, external],
+        })
+        .collect())
+}

@@ -17,7 +17,7 @@ use std::collections::BTreeMap;
 use serde::Deserialize;
 
 use super::error::{quote_cell, Location, RtestError};
-use super::series::{csv_error, LineCounter};
+use super::series::{csv_error, parse_decimal, LineCounter};
 
 /// Lines (not comments) searched for the header: a metadata block longer than this is not
 /// recognised.
@@ -439,12 +439,9 @@ pub fn read_table(
         for (k, col) in columns.iter_mut().enumerate() {
             let text = record.get(index[k]).unwrap_or("");
             // A decimal comma: only where `,` cannot be the separator, and never beside a `.`.
-            let value = if separator != b',' && text.contains(',') && !text.contains('.') {
-                decimal_comma = true;
-                parse_cell(&text.replace(',', "."), text, name, line, &specs[k].name)?
-            } else {
-                parse_cell(text, text, name, line, &specs[k].name)?
-            };
+            let comma = separator != b',';
+            decimal_comma |= comma && text.contains(',');
+            let value = parse_decimal(text, comma, name, line, &specs[k].name)?;
             col.push(value * specs[k].unit.to_contract());
         }
         row_lines.push(line);
@@ -459,29 +456,4 @@ pub fn read_table(
             header_line,
         },
     })
-}
-
-/// Parses one finite number (`text`, as written: `shown`), naming file, line and column
-/// otherwise.
-fn parse_cell(
-    text: &str,
-    shown: &str,
-    source: &str,
-    line: u64,
-    column: &str,
-) -> Result<f64, RtestError> {
-    let at = || Location::file_line(source, line);
-    match text.parse::<f64>() {
-        Err(_) => Err(RtestError::NotANumber {
-            at: at(),
-            column: column.to_string(),
-            value: quote_cell(shown),
-        }),
-        Ok(v) if !v.is_finite() => Err(RtestError::NotFinite {
-            at: at(),
-            column: column.to_string(),
-            value: quote_cell(shown),
-        }),
-        Ok(v) => Ok(v),
-    }
 }

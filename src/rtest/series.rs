@@ -402,15 +402,22 @@ pub(crate) fn csv_error(source: &str, lines: &mut LineCounter, e: csv::Error) ->
     }
 }
 
-/// Parses one finite number, naming file, line and column otherwise.
-pub(crate) fn parse_number(
+/// Parses one finite number, naming file, line and column otherwise; with `decimal_comma`, a cell with `,` and no `.` is read with the comma
+/// as decimal point (files whose separator is not `,`). Errors quote the cell as written.
+pub(crate) fn parse_decimal(
     text: &str,
+    decimal_comma: bool,
     source: &str,
     line: u64,
     column: &str,
 ) -> Result<f64, RtestError> {
     let at = || Location::file_line(source, line);
-    match text.parse::<f64>() {
+    let parsed = if decimal_comma && text.contains(',') && !text.contains('.') {
+        text.replace(',', ".").parse::<f64>()
+    } else {
+        text.parse::<f64>()
+    };
+    match parsed {
         Err(_) => Err(RtestError::NotANumber {
             at: at(),
             column: column.to_string(),

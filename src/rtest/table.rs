@@ -7,7 +7,7 @@ use std::path::Path;
 
 use super::error::{quote_cell, Location, RtestError};
 use super::series::{
-    column_indices, csv_error, parse_number, read_file, require_columns, LineCounter,
+    column_indices, csv_error, parse_decimal, read_file, require_columns, LineCounter,
 };
 use super::CircleResult;
 use crate::axes::{Direction, Eij, Plane};
@@ -98,11 +98,7 @@ pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<Vec<EijRow>, RtestError> {
         .from_reader(bytes);
     // A decimal comma where `,` is not the separator.
     let number = |text: &str, line: u64, column: &str| {
-        if separator != b',' && text.contains(',') && !text.contains('.') {
-            parse_number(&text.replace(',', "."), &name, line, column)
-        } else {
-            parse_number(text, &name, line, column)
-        }
+        parse_decimal(text, separator != b',', &name, line, column)
     };
     let mut counter = LineCounter::new(bytes);
     let mut records = reader.records();

@@ -47,6 +47,19 @@ pub struct TimeOffset {
     pub alignment_ms: Option<f64>,
 }
 
+impl TimeOffset {
+    /// An offset given in `rtest.toml`.
+    fn given(offset_ms: f64, clock: &str) -> Self {
+        TimeOffset {
+            offset_ms,
+            std_err_ms: None,
+            source: OffsetSource::Given,
+            clock: clock.to_string(),
+            alignment_ms: None,
+        }
+    }
+}
+
 /// What was found about one clock (the tests sharing one offset).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ClockReport {
@@ -107,13 +120,7 @@ pub(super) fn align_clock(
             continue;
         };
         if let Some(o) = inputs[i].time_offset_ms {
-            offsets[i] = Some(TimeOffset {
-                offset_ms: o,
-                std_err_ms: None,
-                source: OffsetSource::Given,
-                clock: clock.to_string(),
-                alignment_ms: None,
-            });
+            offsets[i] = Some(TimeOffset::given(o, clock));
             continue;
         }
         let period = internal_period(&inputs[i], internal, &prepared[i].opts)?;
@@ -253,15 +260,7 @@ pub(super) fn lag_of_clock(
     let mut free = Vec::new();
     for &i in members {
         match inputs[i].time_offset_ms {
-            Some(o) => {
-                offsets[i] = Some(TimeOffset {
-                    offset_ms: o,
-                    std_err_ms: None,
-                    source: OffsetSource::Given,
-                    clock: clock.to_string(),
-                    alignment_ms: None,
-                })
-            }
+            Some(o) => offsets[i] = Some(TimeOffset::given(o, clock)),
             None => free.push((i, 0.0)),
         }
     }
