@@ -350,17 +350,73 @@ impl ClosedLoop {
         })
     }
 
-    /// Frequency response H(jω) = C (jωI − A)⁻¹ B + D (ny × nu, complex).
+    /// Frequency response H(jω) = C (jωI − A)⁻¹ B + D (ny × nu, complex): the columns of
+    /// [`ClosedLoop::response`] for unit inputs.
     pub fn frequency_response(&self, omega: f64) -> Option<DMatrix<Complex<f64>>> {
+        let nu = self.b.ncols();
+        let units: Vec<Vec<Complex<f64>>> = (0..nu)
+            .map(|k| {
+                let mut u = vec![Complex::new(0.0, 0.0); nu];
+                u[k] = Complex::new(1.0, 0.0);
+                u
+            })
+            .collect();
+        let y = self.responses(omega, &units)?;
+        Some(DMatrix::from_fn(self.c.nrows(), nu, |o, k| y[k][o]))
+    }
+
+    /// Output phasors Y = H(jω) U = C (jωI − A)⁻¹ B U + D U of input phasors `u` (closed-loop
+    /// input order): the steady state of sinusoidal set points at ω. `None` if jωI − A is
+    /// singular (a pole on the imaginary axis at ω).
+    pub fn response(&self, omega: f64, u: &[Complex<f64>]) -> Option<Vec<Complex<f64>>> {
+        Some(
+            self.responses(omega, std::slice::from_ref(&u.to_vec()))?
+                .remove(0),
+        )
+    }
+
+    /// [`ClosedLoop::response`] for several input vectors with one LU of jωI − A (faer's
+    /// partial-pivoting LU: the one implementation of H(jω), used by the harmonic simulation).
+    fn responses(
+        &self,
+        omega: f64,
+        inputs: &[Vec<Complex<f64>>],
+    ) -> Option<Vec<Vec<Complex<f64>>>> {
+        use faer::linalg::solvers::Solve;
         let n = self.a.nrows();
-        let mut m: DMatrix<Complex<f64>> = self.a.map(|x| Complex::new(-x, 0.0));
-        for i in 0..n {
-            m[(i, i)] += Complex::new(0.0, omega);
+        let (nu, ny) = (self.b.ncols(), self.c.nrows());
+        let zero = Complex::new(0.0, 0.0);
+        let m = faer::Mat::<Complex<f64>>::from_fn(n, n, |i, k| {
+            let d = if i == k {
+                Complex::new(0.0, omega)
+            } else {
+                zero
+            };
+            d - Complex::new(self.a[(i, k)], 0.0)
+        });
+        let rhs = faer::Mat::<Complex<f64>>::from_fn(n, inputs.len(), |i, c| {
+            (0..nu).map(|k| inputs[c][k] * self.b[(i, k)]).sum()
+        });
+        let x = m.partial_piv_lu().solve(&rhs);
+        let finite = |z: Complex<f64>| z.re.is_finite() && z.im.is_finite();
+        if (0..inputs.len()).any(|c| (0..n).any(|i| !finite(x[(i, c)]))) {
+            return None;
         }
-        let bc = self.b.map(|x| Complex::new(x, 0.0));
-        let x = m.lu().solve(&bc)?;
-        let cc = self.c.map(|x| Complex::new(x, 0.0));
-        Some(cc * x + self.d.map(|x| Complex::new(x, 0.0)))
+        Some(
+            inputs
+                .iter()
+                .enumerate()
+                .map(|(c, u)| {
+                    (0..ny)
+                        .map(|o| {
+                            let cx: Complex<f64> = (0..n).map(|i| x[(i, c)] * self.c[(o, i)]).sum();
+                            let du: Complex<f64> = (0..nu).map(|k| u[k] * self.d[(o, k)]).sum();
+                            cx + du
+                        })
+                        .collect()
+                })
+                .collect(),
+        )
     }
 
     /// The state of rest in equilibrium at constant set input `u` (zero velocity and

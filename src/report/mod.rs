@@ -36,16 +36,10 @@ pub use map_plot::map_svg;
 pub use move_plot::{move_svg, MoveData};
 pub use stiffness::stiffness_html;
 
-/// Reads an input file of the report; a missing file says so in plain words.
+/// Reads an input file of the report (the R-Test reader's, telling a missing file and a folder
+/// apart from other failures).
 pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>, ReportError> {
-    std::fs::read(path).map_err(|e| ReportError::Read {
-        path: path.display().to_string(),
-        message: if e.kind() == std::io::ErrorKind::NotFound {
-            "file not found".into()
-        } else {
-            e.to_string()
-        },
-    })
+    Ok(crate::rtest::series::read_file(path)?)
 }
 
 /// Errors of the figures and the report; every message is one line naming the file or key.
@@ -54,14 +48,6 @@ pub enum ReportError {
     /// Reading or evaluating a circle test failed.
     #[error(transparent)]
     Rtest(#[from] crate::rtest::RtestError),
-    /// A file could not be read.
-    #[error("{path}: {message}")]
-    Read {
-        /// The file.
-        path: String,
-        /// What went wrong.
-        message: String,
-    },
     /// A file holds something unusable (missing column, bad number, ...).
     #[error("{source_name}: {message}")]
     BadInput {

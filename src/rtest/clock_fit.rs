@@ -24,7 +24,8 @@ use std::collections::BTreeMap;
 
 use nalgebra::{DMatrix, Matrix2};
 
-use super::fit::{joint_lstsq, lstsq};
+use super::fit::joint_lstsq;
+use super::lstsq::lstsq;
 use super::normalise::Normalised;
 use crate::axes::{Eij, Plane};
 

@@ -227,10 +227,8 @@ pub enum RtestError {
     },
     /// External minus internal beyond the R-Test measuring range.
     #[error(
-        "{at}: column {}: deviation {deviation_mm:.4} mm from {} is beyond the R-Test range \
-         ±{range_mm} mm{}",
-        crate::rtest::series::EXT_COLUMNS[axis.index()],
-        crate::rtest::series::INT_COLUMNS[axis.index()],
+        "{at}: column {axis}_ext_mm: deviation {deviation_mm:.4} mm from {axis}_int_mm is beyond \
+         the R-Test range ±{range_mm} mm{}",
         if *looks_like_um { " (values look like µm, expected mm)" } else { "" }
     )]
     ProbeRange {

@@ -16,8 +16,7 @@ use std::collections::BTreeMap;
 
 use serde::Deserialize;
 
-use super::error::{quote_cell, Location, RtestError};
-use super::series::{csv_error, parse_decimal, LineCounter};
+use super::error::{quote_cell, Line, Location, RtestError};
 
 /// Lines (not comments) searched for the header: a metadata block longer than this is not
 /// recognised.
@@ -456,4 +455,113 @@ pub fn read_table(
             header_line,
         },
     })
+}
+
+/// Physical line numbers (1-based) of byte offsets, counted forward through the file: the CSV
+/// reader's own line count leaves out blank lines.
+pub(crate) struct LineCounter<'a> {
+    bytes: &'a [u8],
+    byte: usize,
+    line: u64,
+}
+
+impl<'a> LineCounter<'a> {
+    /// A counter at the start of `bytes` (line 1).
+    pub(crate) fn new(bytes: &'a [u8]) -> Self {
+        Self::starting_at(bytes, 1)
+    }
+
+    /// A counter at the start of `bytes`, which begin on line `line` of their file.
+    pub(crate) fn starting_at(bytes: &'a [u8], line: u64) -> Self {
+        LineCounter {
+            bytes,
+            byte: 0,
+            line,
+        }
+    }
+
+    /// The line holding byte `offset`; offsets must not decrease between calls.
+    pub(crate) fn line_of(&mut self, offset: u64) -> u64 {
+        let end = (offset as usize).min(self.bytes.len());
+        if end > self.byte {
+            let newlines = self.bytes[self.byte..end]
+                .iter()
+                .filter(|&&b| b == b'\n')
+                .count();
+            self.line += newlines as u64;
+            self.byte = end;
+        }
+        self.line
+    }
+
+    /// The line of a record: of its first byte that is not a line end (the reader's record
+    /// position may point at the end of the previous line or at skipped blank lines).
+    pub(crate) fn line_of_record(&mut self, record: &csv::StringRecord) -> u64 {
+        match record.position() {
+            Some(p) => self.line_of_position(p),
+            None => self.line,
+        }
+    }
+
+    /// The line of a reader position, skipping line ends as [`Self::line_of_record`] does.
+    pub(crate) fn line_of_position(&mut self, p: &csv::Position) -> u64 {
+        let mut start = p.byte() as usize;
+        while self
+            .bytes
+            .get(start)
+            .is_some_and(|b| *b == b'\r' || *b == b'\n')
+        {
+            start += 1;
+        }
+        self.line_of(start as u64)
+    }
+}
+
+/// Turns a CSV reader error into a one-line error naming the line.
+pub(crate) fn csv_error(source: &str, lines: &mut LineCounter, e: csv::Error) -> RtestError {
+    let line = e.position().map(|p| lines.line_of_position(p));
+    let message = match e.kind() {
+        csv::ErrorKind::UnequalLengths {
+            expected_len, len, ..
+        } => format!("{len} field(s), the header has {expected_len}"),
+        csv::ErrorKind::Utf8 { .. } => "not valid UTF-8 text".to_string(),
+        _ => e.to_string(),
+    };
+    RtestError::Csv {
+        at: Location {
+            source: source.to_string(),
+            line: line.map(Line::File),
+        },
+        message,
+    }
+}
+
+/// Parses one finite number, naming file, line and column otherwise; with `decimal_comma`, a cell with `,` and no `.` is read with the comma
+/// as decimal point (files whose separator is not `,`). Errors quote the cell as written.
+pub(crate) fn parse_decimal(
+    text: &str,
+    decimal_comma: bool,
+    source: &str,
+    line: u64,
+    column: &str,
+) -> Result<f64, RtestError> {
+    let at = || Location::file_line(source, line);
+    let parsed = if decimal_comma && text.contains(',') && !text.contains('.') {
+        text.replace(',', ".").parse::<f64>()
+    } else {
+        text.parse::<f64>()
+    };
+    match parsed {
+        Err(_) => Err(RtestError::NotANumber {
+            at: at(),
+            column: column.to_string(),
+            value: quote_cell(text),
+        }),
+        Ok(v) if !v.is_finite() => Err(RtestError::NotFinite {
+            at: at(),
+            column: column.to_string(),
+            value: quote_cell(text),
+        }),
+        Ok(v) => Ok(v),
+    }
 }

@@ -44,6 +44,7 @@ pub mod fit;
 pub mod inputs;
 pub mod iso230;
 pub mod layout;
+pub mod lstsq;
 pub mod normalise;
 pub mod pooled;
 pub mod series;

@@ -2,7 +2,7 @@
 //! revolutions, ω and the set accelerations, plus the plausibility checks on units and range.
 
 use super::error::{Location, RtestError};
-use super::fit::lstsq;
+use super::lstsq::lstsq;
 use super::series::{CircleSeries, INT_COLUMNS};
 use super::EvalOptions;
 use crate::axes::{Axis, Plane};

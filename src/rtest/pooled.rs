@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use nalgebra::DMatrix;
 
 use super::error::{Location, RtestError};
-use super::fit::{lstsq, Lstsq};
+use super::lstsq::{lstsq, Lstsq};
 use super::normalise::{normalise, Normalised};
 use super::{CircleSeries, EvalOptions};
 use crate::axes::{Axis, Direction, Eij, Plane};

@@ -6,9 +6,8 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::error::{quote_cell, Location, RtestError};
-use super::series::{
-    column_indices, csv_error, parse_decimal, read_file, require_columns, LineCounter,
-};
+use super::layout::{csv_error, parse_decimal, LineCounter};
+use super::series::{column_indices, read_file, require_columns};
 use super::CircleResult;
 use crate::axes::{Direction, Eij, Plane};
 

@@ -1,6 +1,7 @@
 //! Harmonic steady state: a circle's set points are sinusoids at one frequency, so in steady
 //! state every output is y(t) = Re(Y e^{jωt}) with Y = H(jω) U, H(jω) = C (jωI − A)⁻¹ B + D —
-//! one complex solve instead of a time integration (faer's partial-pivoting LU).
+//! one complex solve instead of a time integration ([`ClosedLoop::response`], faer's
+//! partial-pivoting LU).
 //!
 //! For the circle a = r·cos ωt, b = r·sin ωt (paper eq. 3–4, ω < 0 for cw) the input phasors
 //! are U_a = (r, jωr, −ω²r) and U_b = (−jr, ωr, jω²r) for (position, velocity, acceleration).
@@ -10,8 +11,7 @@
 use super::Run;
 use crate::axes::{Direction, Plane};
 use crate::control::ClosedLoop;
-use faer::linalg::solvers::Solve;
-use faer::{c64, Mat};
+use faer::c64;
 
 /// The steady-state complex amplitudes of the closed loop's inputs and outputs for a circle.
 #[derive(Debug, Clone, PartialEq)]
@@ -56,29 +56,7 @@ pub fn circle_phasors(
         };
         u[3 * i..3 * i + 3].copy_from_slice(&v);
     }
-    let n = cl.a.nrows();
-    let m = Mat::<c64>::from_fn(n, n, |i, k| {
-        let d = if i == k {
-            c64::new(0.0, omega)
-        } else {
-            c64::new(0.0, 0.0)
-        };
-        d - c64::new(cl.a[(i, k)], 0.0)
-    });
-    let rhs = Mat::<c64>::from_fn(n, 1, |i, _| (0..nu).map(|k| u[k] * cl.b[(i, k)]).sum());
-    let lu = m.partial_piv_lu();
-    let x = lu.solve(&rhs);
-    if (0..n).any(|i| !(x[(i, 0)].re.is_finite() && x[(i, 0)].im.is_finite())) {
-        return None;
-    }
-    let ny = cl.c.nrows();
-    let outputs = (0..ny)
-        .map(|o| {
-            let cx: c64 = (0..n).map(|i| x[(i, 0)] * cl.c[(o, i)]).sum();
-            let du: c64 = (0..nu).map(|k| u[k] * cl.d[(o, k)]).sum();
-            cx + du
-        })
-        .collect();
+    let outputs = cl.response(omega, &u)?;
     Some(CirclePhasors {
         omega,
         inputs: u,
