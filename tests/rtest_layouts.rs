@@ -594,3 +594,51 @@ fn iso_230_4_figures_match_hand_calculations() {
     assert!((g - 2.0 * off * 1e3).abs() < 1e-6, "G(b) = {g}");
     assert!(path_figures(&cw.0, &cw.1, r).unwrap().circular_deviation_um < 1e-6);
 }
+
+/// An R-Test logger that ran through a whole session: the external file holds a minute of rest
+/// before and after the circle (2.5 kHz, its own clock), the CNC trace only the test. The
+/// alignment searches the whole session and finds the offset of the one test (the trajectory
+/// alone: one test does not separate it from cross-talk, which the output says).
+#[test]
+fn a_session_long_probe_record_is_aligned() {
+    let d = Scratch::new("session");
+    let c = simulated(Direction::Ccw, 5.0, 5000.0, 0.0, 0);
+    let offset_s = 61.2345;
+    let mut int = String::from("t_s,x_int_mm,y_int_mm,z_int_mm\n");
+    for i in (0..c.t.len()).step_by(5) {
+        int.push_str(&format!(
+            "{},{},{},{}\n",
+            c.t[i], c.int[0][i], c.int[1][i], c.int[2][i]
+        ));
+    }
+    let mut ext = String::from("t_s,x_ext_mm,y_ext_mm,z_ext_mm\n");
+    let last = c.t.len() - 1;
+    let row = |t: f64, i: usize| format!("{t},{},{},{}\n", c.ext[0][i], c.ext[1][i], c.ext[2][i]);
+    // 60 s at rest at the start point, the test, 60 s at rest at its end point.
+    let (t0, dt) = (c.t[0] - offset_s, 4e-4);
+    let rest = (60.0 / dt) as usize;
+    for k in (1..=rest).rev() {
+        ext.push_str(&row(t0 - k as f64 * dt, 0));
+    }
+    for i in (0..c.t.len()).step_by(2) {
+        ext.push_str(&row(c.t[i] - offset_s, i));
+    }
+    let t1 = c.t[last - last % 2] - offset_s;
+    for k in 1..=rest {
+        ext.push_str(&row(t1 + k as f64 * dt, last - last % 2));
+    }
+    d.write("m/cnc.csv", int);
+    d.write("m/probe.csv", ext);
+    d.write(
+        "m/rtest.toml",
+        "radius_mm = 2.0\n[[test]]\ninternal = \"cnc.csv\"\nexternal = \"probe.csv\"\n",
+    );
+    let suite = evaluate_folder(&d.path("m"), &SuiteOptions::default());
+    let o = suite.tests[0].time_offset.as_ref().unwrap();
+    assert_eq!(o.source, OffsetSource::Trajectory);
+    assert!(
+        (o.offset_ms - offset_s * 1e3).abs() < 0.05,
+        "{} ms",
+        o.offset_ms
+    );
+}

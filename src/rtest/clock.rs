@@ -168,8 +168,16 @@ fn cubic_weights(times: &[f64], t: f64, hint: &mut usize) -> Option<(usize, [f64
     if n < 4 || !(t >= times[1] && t <= times[n - 2]) {
         return None;
     }
-    // Interval j: times[j] <= t < times[j+1] with 1 <= j <= n − 3.
+    // Interval j: times[j] <= t < times[j+1] with 1 <= j <= n − 3; found by bisection when the
+    // hint is more than a few samples off (the first call of a pass over a long record).
     let mut j = (*hint).clamp(1, n - 3);
+    let near = |k: usize| times[k.saturating_sub(8).max(1)] <= t && t < times[(k + 8).min(n - 2)];
+    if !near(j) {
+        j = times
+            .partition_point(|&x| x <= t)
+            .saturating_sub(1)
+            .clamp(1, n - 3);
+    }
     while j > 1 && times[j] > t {
         j -= 1;
     }
@@ -303,9 +311,9 @@ impl CostFunction for Misfit<'_> {
 }
 
 /// Aligns the external path on the internal one: a grid over every offset that leaves
-/// [`MIN_OVERLAP`] of overlap (steps of 1/20 of the shortest period seen in the internal path,
-/// at most 4000 steps), then Brent's method (argmin) between the grid neighbours of the best
-/// point. `period_s` is the circle's period, for the grid step and the uniqueness check.
+/// [`MIN_OVERLAP`] of overlap (steps of 1/20 of the circle period, at most 200 000 steps; the
+/// misfit of the grid on about 25 internal samples per period), then Brent's method (argmin,
+/// on every sample) between the grid neighbours of the best point. `period_s` is the circle's period, for the grid step and the uniqueness check.
 pub fn align(
     internal: &Recording,
     external: &Recording,
@@ -314,9 +322,12 @@ pub fn align(
     let name = format!("{} + {}", internal.source, external.source);
     let lo = internal.t_s[0] - external.t_s[external.t_s.len() - 1];
     let hi = internal.t_s[internal.t_s.len() - 1] - external.t_s[0];
-    let step = (period_s / 20.0).max((hi - lo) / 4000.0);
-    // About 2000 internal samples per evaluation of the misfit.
-    let stride = (internal.t_s.len() / 2000).max(1);
+    // A long external record (a logger running through a whole session) makes the grid long;
+    // beyond 200 000 steps it is coarsened.
+    let step = (period_s / 20.0).max((hi - lo) / 200_000.0);
+    // About 25 internal samples per circle period, at most 1000, per evaluation of the misfit.
+    let samples = (25.0 * internal.span_s() / period_s).clamp(100.0, 1000.0) as usize;
+    let stride = (internal.t_s.len() / samples).max(1);
     let steps = ((hi - lo) / step).ceil() as usize;
     let grid: Vec<(f64, f64)> = (0..=steps)
         .filter_map(|k| {
