@@ -19,7 +19,7 @@ use eij::axes::{Axis, Direction, Eij, Plane};
 use eij::control::ClosedLoop;
 use eij::rtest::inputs::expand_tests;
 use eij::rtest::iso230::{bidirectional_deviation, path_figures};
-use eij::rtest::suite::{evaluate_tests, OffsetSource, Suite, SuiteOptions};
+use eij::rtest::suite::{evaluate_tests, EvaluatedTest, OffsetSource, Suite, SuiteOptions};
 use eij::sim::setpoint::Circle;
 use eij::sim::{output, simulate};
 
@@ -461,18 +461,37 @@ fn a_lagging_logger_is_found_and_corrected() {
         },
     );
     for (t, r) in corrected.tests.iter().zip(&clean.tests) {
-        let largest = r.result.eij.values().fold(0.0f64, |m, v| m.max(v.abs()));
-        let diff = max_diff(&t.result.eij, &r.result.eij);
-        assert!(
-            diff < 0.02 * largest,
-            "{}: {diff} of {largest}",
-            t.input.name()
-        );
-        assert_eq!(
-            t.time_offset.as_ref().unwrap().source,
-            OffsetSource::JointFit
-        );
+        assert_corrected(t, r, OffsetSource::JointFit);
     }
+
+    // A known lag stated per test in rtest.toml corrects alike.
+    let mut toml = String::from("radius_mm = 2.0\n");
+    for (dir, accel) in BOTH_DIRECTIONS_TWO_ACCELERATIONS {
+        toml.push_str(&format!(
+            "[[test]]\nfile = \"{dir}_{accel}.csv\"\ntime_offset_ms = -0.2\n"
+        ));
+    }
+    d.write("lag/rtest.toml", toml);
+    let given = evaluate_folder(&d.path("lag"), &SuiteOptions::default());
+    for (t, r) in given.tests.iter().zip(&clean.tests) {
+        assert_corrected(t, r, OffsetSource::Given);
+    }
+}
+
+/// A test corrected for a lag gives the EIJ of the unlagged test within 2 % of the largest.
+fn assert_corrected(t: &EvaluatedTest, clean: &EvaluatedTest, source: OffsetSource) {
+    let largest = clean
+        .result
+        .eij
+        .values()
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    let diff = max_diff(&t.result.eij, &clean.result.eij);
+    assert!(
+        diff < 0.02 * largest,
+        "{}: {diff} of {largest}",
+        t.input.name()
+    );
+    assert_eq!(t.time_offset.as_ref().unwrap().source, source);
 }
 
 /// Servo mismatch: the X path 3 % smaller than the Z path (the X readings scaled by 0.97 about

@@ -68,11 +68,11 @@ pub struct TestEntry {
     pub feed_mm_min: Option<f64>,
     /// Free text carried into the outputs.
     pub note: Option<String>,
-    /// The clock group of a two-system test: tests of one group share one constant clock
-    /// offset (default: one group per folder).
+    /// The clock group: tests of one group share one constant clock offset (default: one
+    /// group per folder; single-file and two-system tests are grouped apart).
     pub clock: Option<String>,
     /// A known clock offset (internal clock minus external clock), ms: used as given, not
-    /// estimated.
+    /// estimated (for a single file: the lag of its external columns, negative when they lag).
     pub time_offset_ms: Option<f64>,
 }
 
@@ -268,18 +268,6 @@ fn test_entry(
         if !o.is_finite() {
             return Err(bad(&key("time_offset_ms"), format!("{o} must be finite")));
         }
-        if matches!(recording, Recording::Single(_)) {
-            return Err(bad(
-                &key("time_offset_ms"),
-                "applies to tests recorded by two systems (internal and external)".into(),
-            ));
-        }
-    }
-    if t.clock.is_some() && matches!(recording, Recording::Single(_)) {
-        return Err(bad(
-            &key("clock"),
-            "applies to tests recorded by two systems (internal and external)".into(),
-        ));
     }
     Ok(TestEntry {
         number,
