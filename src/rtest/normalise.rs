@@ -383,8 +383,11 @@ fn steady_revolutions(
     let first = (k0..=k1)
         .find(|&k| u[k] - u[k0] >= 0.5 * slack)
         .unwrap_or(k0);
+    // The window ends (exclusive) at the sample nearest to whole revolutions after `first`:
+    // a strict `≥` would, on rounding, take one sample more now and then, so that EIJ jump by
+    // ~1e-4 relative between neighbouring parameter values (a noisy cost for identification).
     let end = (first + 1..=k1)
-        .find(|&k| u[k] - u[first] >= revolutions * TAU)
+        .find(|&k| u[k] - u[first] >= revolutions * TAU - 0.5 * (u[k] - u[k - 1]))
         .unwrap_or(k1 + 1);
     Ok((first, end, revolutions as usize))
 }
