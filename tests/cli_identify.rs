@@ -134,11 +134,39 @@ fn reports_are_identical_across_runs_and_thread_counts() {
     assert_eq!(one, two);
 }
 
+/// A refused fit: non-zero exit, the diagnosis as the last line of standard error (after the
+/// warnings), no machine file, and the report the user asked for with status `refused`.
+fn assert_refused(s: &Scratch, out: &Output, expected: &str) -> serde_json::Value {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "succeeded: {stderr}");
+    let last = stderr.lines().last().unwrap_or_default();
+    assert!(
+        last.contains(expected),
+        "'{expected}' not in the last line of {stderr}"
+    );
+    assert!(last.contains("nothing exported"), "{last}");
+    assert!(
+        stderr
+            .lines()
+            .all(|l| l == last || l.starts_with("warning: ")),
+        "{stderr}"
+    );
+    assert!(
+        !s.path("id.toml").exists(),
+        "machine exported on a refused fit"
+    );
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(s.path("id.json")).unwrap()).unwrap();
+    assert_eq!(json["status"], "refused");
+    assert!(json["refusal"].as_str().unwrap().contains(expected));
+    json
+}
+
 #[test]
 fn non_convergence_exports_nothing() {
     let s = Scratch::new("iters");
     let out = identify(&s, &["--max-iters", "1"]);
-    assert_failed_cleanly(&s, &out, "did not converge in 1 iterations");
+    assert_refused(&s, &out, "did not converge in 1 iterations");
 }
 
 #[test]
@@ -146,9 +174,68 @@ fn parameter_at_its_bound_exports_nothing() {
     let s = Scratch::new("bound");
     std::fs::write(s.path("cfg.toml"), "min_factor = 0.6\n").unwrap();
     let cfg = s.path("cfg.toml");
-    let out = identify(&s, &["--config", cfg.to_str().unwrap()]);
+    let out = identify(&s, &["--config", cfg.to_str().unwrap(), "--no-design"]);
     std::fs::remove_file(&cfg).unwrap();
-    assert_failed_cleanly(&s, &out, "z.guideway_normal ended at its bound 0.6");
+    let json = assert_refused(&s, &out, "z.guideway_normal ended at its bound 0.6");
+    assert_eq!(json["parameters"][0]["at_bound"], true);
+}
+
+#[test]
+fn a_factor_just_off_its_bound_counts_as_on_it() {
+    // The bound sits 0.06 % below where the data want the factor: the optimiser stops at
+    // 1.0006 × bound or on it; either way the fit is refused (relative, not absolute, check).
+    let s = Scratch::new("bound-rel");
+    let free = identify(&s, &["--no-design"]);
+    assert!(free.status.success());
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(s.path("id.json")).unwrap()).unwrap();
+    let p = json["parameters"][0]["identified"].as_f64().unwrap();
+    std::fs::remove_file(s.path("id.toml")).unwrap();
+    std::fs::remove_file(s.path("id.json")).unwrap();
+    std::fs::write(s.path("cfg.toml"), format!("min_factor = {}\n", p / 1.0006)).unwrap();
+    let cfg = s.path("cfg.toml");
+    let out = identify(&s, &["--config", cfg.to_str().unwrap(), "--no-design"]);
+    std::fs::remove_file(&cfg).unwrap();
+    assert_refused(&s, &out, "z.guideway_normal ended at its bound");
+}
+
+#[test]
+fn a_trial_step_that_cannot_be_simulated_is_rejected_not_fatal() {
+    // The catalogue guideways and a free Z screw: the data want a screw so soft that the Z
+    // drive's closed loop goes unstable on the way. Trial steps there are rejected; the fit
+    // ends at the stability limit and is refused with that diagnosis (no abort mid-way).
+    let s = Scratch::new("unstable");
+    let out = Command::new(env!("CARGO_BIN_EXE_eij"))
+        .current_dir(root())
+        .args([
+            "identify",
+            "--quiet",
+            "--no-design",
+            "--param",
+            "z.screw",
+            "--measured",
+        ])
+        .arg(root().join("measurements/demo-vmc"))
+        .arg("--out")
+        .arg(s.path("id.toml"))
+        .arg("--report")
+        .arg(s.path("id.json"))
+        .output()
+        .unwrap();
+    let json = assert_refused(
+        &s,
+        &out,
+        "ended at the limit of what the model can simulate",
+    );
+    assert!(json["rejected_steps"].as_u64().unwrap() > 0);
+    // --quiet silences the tables, not the warnings.
+    assert!(out.stdout.is_empty());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("warning: χ² test failed"), "{stderr}");
+    assert!(
+        stderr.contains("do not cover such a model error"),
+        "{stderr}"
+    );
 }
 
 #[test]
@@ -242,4 +329,33 @@ fn nelder_mead_fallback_agrees_with_levenberg_marquardt() {
             "parameter {i}: LM {a}, Nelder-Mead {b}"
         );
     }
+}
+
+#[test]
+fn default_outputs_are_named_after_the_machine() {
+    let s = Scratch::new("mymill");
+    let text = common::demo_text().replace("name = \"demo-vmc\"", "name = \"mymill\"");
+    let machine = s.write("mymill.toml", text);
+    let out = Command::new(env!("CARGO_BIN_EXE_eij"))
+        .current_dir(&s.0)
+        .args([
+            "identify",
+            "--quiet",
+            "--no-design",
+            "--param",
+            "z.guideway_normal",
+        ])
+        .args(["--machine", &machine, "--measured"])
+        .arg(root().join("measurements/demo-vmc/pos-a/zx_ccw_5.csv"))
+        .arg(root().join("measurements/demo-vmc/pos-a/zx_cw_8.csv"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(s.path("out/mymill-identified.toml").is_file());
+    assert!(s.path("out/mymill-identify-report.json").is_file());
+    assert!(!s.path("out/demo-vmc-identified.toml").exists());
 }

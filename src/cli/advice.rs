@@ -30,6 +30,9 @@ pub fn identify(e: IdentError) -> anyhow::Error {
         IdentError::AtBound { .. } => anyhow::anyhow!(
             "{e}; widen the bounds or check the data; nothing exported"
         ),
+        IdentError::AtSimulationLimit { .. } => anyhow::anyhow!(
+            "{e}; check the model (a compliance missing elsewhere, the controller gains) or the data; nothing exported"
+        ),
         IdentError::Conditions {
             source: PredictError::PositionLength { .. },
             ..

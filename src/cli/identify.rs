@@ -5,7 +5,10 @@ use anyhow::{bail, Context};
 use eij::ident::config::{IdentConfig, KnownGood};
 use eij::ident::measured::{self, MeasuredOptions};
 use eij::ident::report::{self, Provenance};
-use eij::ident::{identify, IdentResult, Method, Parameter, Problem, Settings, SolverKind};
+use eij::ident::validation::{self, Validation};
+use eij::ident::{
+    identify, IdentResult, Method, Parameter, Problem, Settings, SolverKind, StaticTerms,
+};
 use eij::machine::Machine;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
@@ -13,10 +16,9 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
-/// The main job's output folder (created when missing) and default outputs.
+/// The default output folder (created when missing), where the default outputs are named
+/// after the machine: `out/<machine name>-identified.toml`, `out/<machine name>-identify-report.json`.
 const DEFAULT_DIR: &str = "out";
-const DEFAULT_OUT: &str = "out/demo-vmc-identified.toml";
-const DEFAULT_REPORT: &str = "out/demo-vmc-identify-report.json";
 
 /// Arguments of `eij identify`.
 #[derive(Debug, clap::Args)]
@@ -31,23 +33,29 @@ pub struct IdentifyArgs {
     /// R-Test CSV files, folders of them, or EIJ tables.
     #[arg(long, value_name = "PATH", num_args = 1.., default_value = "measurements/demo-vmc")]
     measured: Vec<PathBuf>,
-    /// The identified machine file.
-    #[arg(
-        long,
-        value_name = "FILE.toml",
-        default_value = "out/demo-vmc-identified.toml"
-    )]
-    out: PathBuf,
-    /// The report JSON.
-    #[arg(
-        long,
-        value_name = "FILE.json",
-        default_value = "out/demo-vmc-identify-report.json"
-    )]
-    report: PathBuf,
+    /// The identified machine file [default: out/<machine name>-identified.toml]. Not written
+    /// when the fit ends on a bound or does not converge.
+    #[arg(long, value_name = "FILE.toml")]
+    out: Option<PathBuf>,
+    /// The report JSON [default: out/<machine name>-identify-report.json]. When given, it is
+    /// also written for a refused fit (with the diagnosis); the default one is not.
+    #[arg(long, value_name = "FILE.json")]
+    report: Option<PathBuf>,
+    /// Hold-out validation: R-Test files, folders or EIJ tables not fitted, predicted by the
+    /// identified model and compared with their measurement uncertainty.
+    #[arg(long, value_name = "PATH", num_args = 1..)]
+    validate: Vec<PathBuf>,
+    /// Static (acceleration-independent) terms fitted with the EIJ: auto (shared per plane and
+    /// circle centre where separable, reversal terms where the data need them), shared,
+    /// per-direction, none.
+    #[arg(long, value_enum)]
+    static_terms: Option<StaticTermsArg>,
+    /// Skip the ranking of candidate additional tests.
+    #[arg(long)]
+    no_design: bool,
     /// Identification settings (TOML: parameters, solver, method, max_iters, tol_cost,
     /// tol_step, min_factor, max_factor, rate_hz, revolutions, radius_mm, position_mm,
-    /// table_std_err_um_s2_per_m).
+    /// table_std_err_um_s2_per_m, static_terms, design).
     #[arg(long, value_name = "FILE.toml")]
     config: Option<PathBuf>,
     /// Parameters to identify, e.g. `z.guideway_normal` (repeatable; default: normal and
@@ -85,7 +93,7 @@ pub struct IdentifyArgs {
     /// test, cost over iterations) as SVG.
     #[arg(long, value_name = "FILE.svg")]
     plot: Option<PathBuf>,
-    /// No progress bar and no tables, only errors.
+    /// No progress bar and no tables; warnings and errors still go to standard error.
     #[arg(long)]
     quiet: bool,
 }
@@ -126,6 +134,30 @@ impl From<SolverArg> for SolverKind {
     }
 }
 
+/// `--static-terms`: the library's [`StaticTerms`] as the command line spells it.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+enum StaticTermsArg {
+    /// Shared terms where separable; reversal terms where the data need them (default).
+    Auto,
+    /// Shared terms where separable, never reversal terms.
+    Shared,
+    /// Shared and reversal terms wherever separable.
+    PerDirection,
+    /// None: every test's EIJ as they are.
+    None,
+}
+
+impl From<StaticTermsArg> for StaticTerms {
+    fn from(s: StaticTermsArg) -> Self {
+        match s {
+            StaticTermsArg::Auto => StaticTerms::Auto,
+            StaticTermsArg::Shared => StaticTerms::Shared,
+            StaticTermsArg::PerDirection => StaticTerms::PerDirection,
+            StaticTermsArg::None => StaticTerms::None,
+        }
+    }
+}
+
 /// Arguments of `eij verify`.
 #[derive(Debug, clap::Args)]
 pub struct VerifyArgs {
@@ -138,6 +170,8 @@ struct Prepared {
     provenance: Provenance,
     /// What reading the measured tests found (conditions, clocks), for the report's warnings.
     warnings: Vec<String>,
+    /// How measured data were read (validation data are read alike).
+    measured_options: MeasuredOptions,
 }
 
 fn prepare(
@@ -145,9 +179,11 @@ fn prepare(
     measured_paths: &[PathBuf],
     config: &IdentConfig,
     cli_params: &[String],
+    design: bool,
 ) -> anyhow::Result<Prepared> {
     let machine = Machine::from_file(machine_path)?;
     let mut settings = Settings::default();
+    settings.design = design;
     let mut mopts = MeasuredOptions::default();
     config.apply(&mut settings, &mut mopts)?;
     let names: Vec<String> = if !cli_params.is_empty() {
@@ -177,6 +213,7 @@ fn prepare(
         problem,
         provenance,
         warnings,
+        measured_options: mopts,
     })
 }
 
@@ -192,6 +229,7 @@ fn progress_bar(quiet: bool, max_iters: u64) -> Option<ProgressBar> {
     Some(bar)
 }
 
+/// Runs the identification with a progress bar; warnings go to standard error, always.
 fn run_identification(prep: &Prepared, quiet: bool) -> anyhow::Result<(IdentResult, f64)> {
     let max_iters = prep.problem.tests().len() as u64;
     let bar = progress_bar(quiet, max_iters.max(1));
@@ -211,104 +249,24 @@ fn run_identification(prep: &Prepared, quiet: bool) -> anyhow::Result<(IdentResu
     }
     let mut result = result.map_err(super::advice::identify)?;
     result.warnings.splice(0..0, prep.warnings.iter().cloned());
+    for w in &result.warnings {
+        eprintln!("warning: {w}");
+    }
     Ok((result, start.elapsed().as_secs_f64()))
 }
 
-fn print_result(prep: &Prepared, result: &IdentResult, seconds: f64) {
-    let p = &prep.problem;
-    println!(
-        "Identified {} from {} tests ({} values), {} iterations, {:.1} s",
-        p.machine().name,
-        p.tests().len(),
-        result.residuals,
-        result.iterations,
-        seconds
-    );
-    println!(
-        "cost Σr² {:.4e} -> {:.4e}   residual std s = {:.3}",
-        result.cost_initial, result.cost_final, result.residual_std
-    );
-    println!("\n  parameter              initial   identified    std err");
-    for q in &result.parameters {
-        match q.std_err {
-            Some(s) => println!(
-                "  {:<22} {:>7.4}   {:>10.4}   {:>8.4}",
-                q.name, q.initial, q.value, s
-            ),
-            None => println!(
-                "  {:<22} {:>7.4}   {:>10}   not identifiable",
-                q.name, q.initial, "-"
-            ),
-        }
-    }
-    let n = result.parameters.len();
-    if n > 1 {
-        println!("\n  correlation");
-        for i in 0..n {
-            let row: Vec<String> = (0..n)
-                .map(|k| format!("{:>6.2}", result.correlation[(i, k)]))
-                .collect();
-            println!("  {:<22} {}", result.parameters[i].name, row.join(" "));
-        }
-    }
-    println!(
-        "\n  {:<36} EIJ   measured ± σ       catalogue (ratio)   identified (ratio)   (µm·s²/m)",
-        "test"
-    );
-    for (i, t) in p.tests().iter().enumerate() {
-        for (e, (m, s)) in &t.measured {
-            let a = result.simulated_initial[i]
-                .get(e)
-                .copied()
-                .unwrap_or(f64::NAN);
-            let b = result.simulated_final[i]
-                .get(e)
-                .copied()
-                .unwrap_or(f64::NAN);
-            let ratio = |x: f64| {
-                if m.abs() > 3.0 * s {
-                    format!("{:>5.2}", x / m)
-                } else {
-                    "    -".to_string()
-                }
-            };
-            println!(
-                "  {:<36} {} {:>8.3} ± {:<6.3}  {:>8.3} ({})     {:>8.3} ({})",
-                t.label(),
-                e,
-                m,
-                s,
-                a,
-                ratio(a),
-                b,
-                ratio(b)
-            );
-        }
-    }
-    let (mut before, mut after) = (Vec::new(), Vec::new());
-    for (i, t) in p.tests().iter().enumerate() {
-        for (e, (m, s)) in &t.measured {
-            if m.abs() > 3.0 * s {
-                before.push(result.simulated_initial[i][e] / m);
-                after.push(result.simulated_final[i][e] / m);
+/// A file name made of the machine name (characters other than letters, digits, `-`, `_`
+/// and `.` replaced by `_`).
+fn file_stem(name: &str) -> String {
+    name.chars()
+        .map(|c| {
+            if c.is_alphanumeric() || "-_.".contains(c) {
+                c
+            } else {
+                '_'
             }
-        }
-    }
-    if !before.is_empty() {
-        let median = |v: &mut Vec<f64>| {
-            v.sort_by(f64::total_cmp);
-            v[v.len() / 2]
-        };
-        println!(
-            "\nsimulated/measured over the {} values beyond 3σ: median {:.2} with the catalogue model, {:.2} identified",
-            before.len(),
-            median(&mut before),
-            median(&mut after)
-        );
-    }
-    for w in &result.warnings {
-        println!("warning: {w}");
-    }
+        })
+        .collect()
 }
 
 /// Runs `eij identify`.
@@ -332,9 +290,24 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
     if let Some(p) = &args.position_mm {
         config.position_mm = Some(p.clone());
     }
-    // Inputs of the run (never overwritten): measured files, the rtest.toml of their folders,
-    // the machine and the config. Outputs are checked before any work.
-    let mut inputs: Vec<PathBuf> = measured::expand(&args.measured)?;
+    if let Some(t) = args.static_terms {
+        config.static_terms = Some(t.into());
+    }
+    if args.no_design {
+        config.design = Some(false);
+    }
+    // Inputs of the run (never overwritten): measured and validation files, the rtest.toml of
+    // their folders, the machine and the config. Outputs are checked before any work.
+    let measured_files = measured::expand(&args.measured)?;
+    let validation_files = measured::expand(&args.validate)?;
+    if let Some(f) = validation_files.iter().find(|f| measured_files.contains(f)) {
+        bail!(
+            "{}: given both as measured and as validation data (hold-out tests must not be fitted)",
+            f.display()
+        );
+    }
+    let mut inputs: Vec<PathBuf> = measured_files;
+    inputs.extend(validation_files);
     let conditions: Vec<PathBuf> = inputs
         .iter()
         .filter_map(|f| {
@@ -349,14 +322,19 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
         inputs.push(c.clone());
     }
     let input_refs: Vec<&Path> = inputs.iter().map(|p| p.as_path()).collect();
-    // Only the main job's default output folder is created; any other must exist.
-    if args.out == Path::new(DEFAULT_OUT) || args.report == Path::new(DEFAULT_REPORT) {
+    let stem = file_stem(&Machine::from_file(&args.machine)?.name);
+    let default_out = Path::new(DEFAULT_DIR).join(format!("{stem}-identified.toml"));
+    let default_report = Path::new(DEFAULT_DIR).join(format!("{stem}-identify-report.json"));
+    let out = args.out.clone().unwrap_or(default_out);
+    let report_path = args.report.clone().unwrap_or(default_report);
+    // Only the default output folder is created; any other must exist.
+    if args.out.is_none() || args.report.is_none() {
         std::fs::create_dir_all(DEFAULT_DIR)
             .with_context(|| format!("{DEFAULT_DIR}: cannot create the folder"))?;
     }
     let outputs: Vec<&Path> = [
-        Some(args.out.as_path()),
-        Some(args.report.as_path()),
+        Some(out.as_path()),
+        Some(report_path.as_path()),
         args.stiffness_out.as_deref(),
         args.plot.as_deref(),
     ]
@@ -365,18 +343,46 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
     .collect();
     eij::io::check_outputs(&outputs, &input_refs)?;
 
-    let prep = prepare(&args.machine, &args.measured, &config, &args.params)?;
+    let prep = prepare(&args.machine, &args.measured, &config, &args.params, true)?;
+    let validation_tests = if args.validate.is_empty() {
+        None
+    } else {
+        Some(measured::load(&args.validate, &prep.measured_options)?)
+    };
     let (result, seconds) = run_identification(&prep, args.quiet)?;
+    let validation = match validation_tests {
+        Some(tests) => Some(check_validation(&prep, &result, tests)?),
+        None => None,
+    };
+    let mut ident_report = report::IdentReport::new(&prep.problem, &result, &prep.provenance);
+    ident_report.validation = validation.as_ref().map(Into::into);
+    if !args.quiet {
+        super::identify_print::print_result(&prep.problem, &result, seconds);
+        if let Some(v) = &validation {
+            super::identify_print::print_validation(v);
+        }
+    }
+    if let Some(refusal) = &result.refusal {
+        // The diagnosis is written where the user asked for a report; nothing is exported.
+        let written = if args.report.is_some() {
+            write_output(&report_path, &ident_report.to_json(), &input_refs)?;
+            format!(" (diagnosis in {})", report_path.display())
+        } else {
+            String::new()
+        };
+        return Err(anyhow::anyhow!(
+            "{}{written}",
+            super::advice::identify(refusal.clone())
+        ));
+    }
     let toml_text = report::machine_toml(&prep.problem, &result, &prep.provenance)
         .context("cannot write the identified machine")?;
-    let ident_report = report::IdentReport::new(&prep.problem, &result, &prep.provenance);
     let svg = match &args.plot {
         Some(_) => Some(eij::report::identification_svg(&ident_report)?),
         None => None,
     };
-    let json = ident_report.to_json();
-    write_output(&args.out, toml_text.as_bytes(), &input_refs)?;
-    write_output(&args.report, &json, &input_refs)?;
+    write_output(&out, toml_text.as_bytes(), &input_refs)?;
+    write_output(&report_path, &ident_report.to_json(), &input_refs)?;
     if let Some(path) = &args.stiffness_out {
         let table = eij::ident::stiffness::identified_table(&prep.problem, &result);
         write_output(path, &table.to_csv(), &input_refs)?;
@@ -385,7 +391,6 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
         write_output(path, svg.as_bytes(), &input_refs)?;
     }
     if !args.quiet {
-        print_result(&prep, &result, seconds);
         let table = args
             .stiffness_out
             .as_ref()
@@ -393,11 +398,28 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
             .unwrap_or_default();
         println!(
             "\nwrote {} and {}{table}",
-            args.out.display(),
-            args.report.display()
+            out.display(),
+            report_path.display()
         );
     }
     Ok(())
+}
+
+/// Validates the identified machine on the held-out tests; a failed validation is a warning.
+fn check_validation(
+    prep: &Prepared,
+    result: &IdentResult,
+    tests: Vec<eij::ident::TestCase>,
+) -> anyhow::Result<Validation> {
+    let v = validation::validate(&result.machine, tests, prep.problem.settings())
+        .map_err(super::advice::identify)?;
+    if !v.passed {
+        eprintln!(
+            "warning: hold-out validation failed: the identified model does not predict the {} held-out value(s) within their measurement uncertainty (χ²/dof = {:.2} over {} degrees of freedom)",
+            v.values, v.chi2_per_dof, v.dof
+        );
+    }
+    Ok(v)
 }
 
 /// Runs `eij verify`.
@@ -438,9 +460,13 @@ pub fn verify(args: VerifyArgs) -> anyhow::Result<()> {
 /// Re-runs one known-good identification; one line per expected value (`ok …` or `FAIL …`).
 pub fn verify_one(file: &Path) -> anyhow::Result<Vec<String>> {
     let k = KnownGood::from_file(file)?;
-    let prep = prepare(&k.machine, &k.measured, &k.settings, &[])?;
+    // The ranking of candidate tests does not change the factors: not needed here.
+    let prep = prepare(&k.machine, &k.measured, &k.settings, &[], false)?;
     let (result, _) = run_identification(&prep, true)?;
     let mut lines = Vec::new();
+    if let Some(refusal) = &result.refusal {
+        lines.push(format!("FAIL {}: {refusal}", file.display()));
+    }
     for (name, exp) in &k.expected {
         let Some(got) = result.parameters.iter().find(|p| &p.name == name) else {
             lines.push(format!(

@@ -6,6 +6,7 @@ mod advice;
 pub mod evaluate;
 mod export;
 mod identify;
+mod identify_print;
 mod machine_args;
 mod map;
 mod modal;

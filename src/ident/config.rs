@@ -37,6 +37,10 @@ pub struct IdentConfig {
     pub position_mm: Option<Vec<f64>>,
     /// σ of table values without a standard error, µm·s²/m.
     pub table_std_err_um_s2_per_m: Option<f64>,
+    /// Static terms fitted with the EIJ: `auto`, `shared`, `per-direction`, `none`.
+    pub static_terms: Option<super::StaticTerms>,
+    /// Rank candidate additional tests after the fit.
+    pub design: Option<bool>,
     /// The file the settings were read from (for messages).
     #[serde(skip)]
     pub source: Option<String>,
@@ -68,6 +72,12 @@ impl IdentConfig {
         }
         if let Some(v) = self.solver {
             s.simulation.solver = v;
+        }
+        if let Some(v) = self.static_terms {
+            s.static_terms = v;
+        }
+        if let Some(v) = self.design {
+            s.design = v;
         }
         if let Some(v) = self.max_iters {
             if v == 0 {

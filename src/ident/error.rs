@@ -61,17 +61,28 @@ pub enum IdentError {
     },
     /// A parameter ended on a bound: the data want a value outside the bounds.
     #[error(
-        "{name} ended at its bound {value} (allowed [{min}, {max}]): the data want a value outside"
+        "{name} ended at its bound {bound} ({value:.6}, allowed [{min}, {max}]): the data want a value outside"
     )]
     AtBound {
         /// Parameter name.
         name: String,
-        /// The value at the bound.
+        /// The value it ended at.
         value: f64,
+        /// The bound it ended on.
+        bound: f64,
         /// Lower bound of the factors.
         min: f64,
         /// Upper bound of the factors.
         max: f64,
+    },
+    /// The fit ended where a neighbouring parameter value cannot be simulated (the closed
+    /// loop's stability limit): the data want a value the model cannot run with.
+    #[error("{names} ended at the limit of what the model can simulate ({detail}): the data want a value beyond it")]
+    AtSimulationLimit {
+        /// The parameters (with their values) at the limit.
+        names: String,
+        /// What fails beyond it.
+        detail: String,
     },
     /// The singular value decomposition of the Jacobian did not converge.
     #[error("the singular value decomposition of the Jacobian did not converge")]

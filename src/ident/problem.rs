@@ -1,8 +1,11 @@
 //! The identification problem: measured tests, the parameters fitted to them, weighted
-//! residuals r = (E_sim − E_meas)/σ and their central-difference Jacobian, and the problem as
-//! argmin sees it ([`Reduced`]: residual operator, Jacobian and cost over the free parameters).
+//! residuals r = P·(E_sim − E_meas)/σ (P eliminates the static terms, see [`super::statics`])
+//! and their central-difference Jacobian, and the problem as argmin sees it ([`Reduced`]:
+//! residual operator, Jacobian and cost over the free parameters; a trial point whose closed
+//! loop cannot be simulated has infinite cost, so that the optimiser rejects the step).
 
 use super::parameters::{to_factor, to_theta, Parameter};
+use super::statics::{Row, Statics};
 use super::{IdentError, Settings};
 use crate::axes::Eij;
 use crate::machine::Machine;
@@ -39,8 +42,14 @@ pub struct Problem {
     settings: Settings,
     /// The tests' conditions prepared for simulation.
     prediction: Prediction,
+    /// The residual rows.
+    rows: Vec<Row>,
+    /// The static terms eliminated from the residuals.
+    statics: Statics,
     /// Parameter sets simulated so far.
     evaluations: AtomicU64,
+    /// Trial points that could not be simulated (rejected steps).
+    unsimulable: AtomicU64,
 }
 
 impl Clone for Problem {
@@ -51,7 +60,10 @@ impl Clone for Problem {
             tests: self.tests.clone(),
             settings: self.settings.clone(),
             prediction: self.prediction.clone(),
+            rows: self.rows.clone(),
+            statics: self.statics.clone(),
             evaluations: AtomicU64::new(self.evaluations()),
+            unsimulable: AtomicU64::new(self.unsimulable()),
         }
     }
 }
@@ -119,14 +131,73 @@ impl Problem {
                 },
                 None => IdentError::Predict(e),
             })?;
-        Ok(Problem {
+        let rows = tests
+            .iter()
+            .enumerate()
+            .flat_map(|(i, t)| {
+                t.measured.iter().map(move |(eij, (_, sigma))| Row {
+                    test: i,
+                    eij: *eij,
+                    sigma: sigma.max(settings.sigma_floor),
+                    r_over_a: t.circle.radius_mm / t.circle.accel_m_s2,
+                    direction: t.circle.direction,
+                })
+            })
+            .collect::<Vec<_>>();
+        let mut problem = Problem {
             machine,
             params,
             tests,
             settings,
             prediction,
+            rows,
+            statics: Statics::new(&[], &[], super::StaticTerms::None, &[]),
             evaluations: AtomicU64::new(0),
-        })
+            unsimulable: AtomicU64::new(0),
+        };
+        problem.statics = problem.statics_with(&[]);
+        Ok(problem)
+    }
+
+    /// The static terms of the settings' mode, with reversal terms forced for the groups
+    /// `reversal` (indices into [`Statics::groups`]).
+    pub fn statics_with(&self, reversal: &[usize]) -> Statics {
+        let tests: Vec<_> = self
+            .tests
+            .iter()
+            .enumerate()
+            .map(|(i, t)| {
+                (
+                    t.circle.plane,
+                    self.position_m(i).to_vec(),
+                    t.circle.accel_m_s2,
+                    t.circle.direction,
+                )
+            })
+            .collect();
+        Statics::new(&tests, &self.rows, self.settings.static_terms, reversal)
+    }
+
+    /// The same problem with other static terms.
+    pub fn with_statics(&self, statics: Statics) -> Problem {
+        let mut p = self.clone();
+        p.statics = statics;
+        p
+    }
+
+    /// The static terms eliminated from the residuals.
+    pub fn statics(&self) -> &Statics {
+        &self.statics
+    }
+
+    /// The residual rows: (test, EIJ, σ) in residual order.
+    pub fn rows(&self) -> &[Row] {
+        &self.rows
+    }
+
+    /// Degrees of freedom of the fit with `free` parameters: m − n − rank(A).
+    pub fn dof(&self, free: usize) -> usize {
+        self.rows.len().saturating_sub(free + self.statics.rank())
     }
 
     /// The parameters.
@@ -157,6 +228,12 @@ impl Problem {
     /// Parameter sets simulated so far (every set counts once, whatever the number of tests).
     pub fn evaluations(&self) -> u64 {
         self.evaluations.load(Ordering::Relaxed)
+    }
+
+    /// Trial points so far that could not be simulated (unstable closed loop, resonance) and
+    /// were rejected as steps.
+    pub fn unsimulable(&self) -> u64 {
+        self.unsimulable.load(Ordering::Relaxed)
     }
 
     /// θ = 1/p of the starting machine.
@@ -192,6 +269,21 @@ impl Problem {
         self.simulate_many_with(thetas, self.settings.simulation.solver)
     }
 
+    /// As [`Problem::simulate_many`], with a result per parameter vector: one that cannot be
+    /// simulated does not spoil the others.
+    pub fn simulate_each(&self, thetas: &[DVector<f64>]) -> Vec<Result<Vec<EijMap>, IdentError>> {
+        match self.simulate_many(thetas) {
+            Ok(all) => all.into_iter().map(Ok).collect(),
+            Err(_) => thetas
+                .iter()
+                .map(|t| {
+                    self.simulate_many(std::slice::from_ref(t))
+                        .map(|mut v| v.remove(0))
+                })
+                .collect(),
+        }
+    }
+
     /// As [`Problem::simulate_many`] with an explicit solver.
     pub fn simulate_many_with(
         &self,
@@ -217,16 +309,22 @@ impl Problem {
             })
     }
 
-    /// Weighted residuals (E_sim − E_meas)/σ in a fixed order: tests, then parameters by name.
+    /// Weighted errors (E_sim − E_meas)/σ in the order of [`Problem::rows`] (tests, then
+    /// parameters by name), before the static terms are eliminated.
+    pub fn errors_of(&self, sims: &[EijMap]) -> DVector<f64> {
+        DVector::from_iterator(
+            self.rows.len(),
+            self.rows.iter().map(|row| {
+                let value = self.tests[row.test].measured[&row.eij].0;
+                let sim = sims[row.test].get(&row.eij).copied().unwrap_or(f64::NAN);
+                (sim - value) / row.sigma
+            }),
+        )
+    }
+
+    /// Residuals r = P·(E_sim − E_meas)/σ: the weighted errors without the static terms.
     pub fn residuals_of(&self, sims: &[EijMap]) -> DVector<f64> {
-        let mut r = Vec::new();
-        for (test, sim) in self.tests.iter().zip(sims) {
-            for (p, (value, sigma)) in &test.measured {
-                let s = sigma.max(self.settings.sigma_floor);
-                r.push((sim.get(p).copied().unwrap_or(f64::NAN) - value) / s);
-            }
-        }
-        DVector::from_vec(r)
+        self.statics.project(&self.errors_of(sims))
     }
 
     /// Residuals at θ.
@@ -235,14 +333,34 @@ impl Problem {
         Ok(self.residuals_of(&sims[0]))
     }
 
-    /// Central-difference Jacobian ∂r/∂θ at θ (all 2n + 1 parameter sets in parallel) and the
-    /// residuals there. Central differences matter: the tests determine some combinations
-    /// thousands of times more weakly than others, and a forward difference's O(h) error would
-    /// swamp those directions.
+    /// Jacobian of the residuals and the residuals at θ (see [`Problem::error_jacobian_at`]):
+    /// the projection is linear and does not depend on θ, so P·J is exact.
     pub fn jacobian_at(
         &self,
         theta: &DVector<f64>,
     ) -> Result<(DMatrix<f64>, DVector<f64>), IdentError> {
+        let (j, e) = self.error_jacobian_at(theta)?;
+        Ok((self.statics.project_matrix(&j), self.statics.project(&e)))
+    }
+
+    /// Central-difference Jacobian of the weighted errors ∂e/∂θ at θ (all 2n + 1 parameter
+    /// sets in parallel) and the errors there. Central differences matter: the tests
+    /// determine some combinations thousands of times more weakly than others, and a forward
+    /// difference's O(h) error would swamp those directions.
+    pub fn error_jacobian_at(
+        &self,
+        theta: &DVector<f64>,
+    ) -> Result<(DMatrix<f64>, DVector<f64>), IdentError> {
+        self.error_jacobian_edges(theta).map(|(j, e, _)| (j, e))
+    }
+
+    /// As [`Problem::error_jacobian_at`], with the parameters whose difference had to be
+    /// one-sided because a neighbour of θ cannot be simulated: θ lies at the edge of what the
+    /// model can run (e.g. the closed loop's stability limit).
+    pub fn error_jacobian_edges(
+        &self,
+        theta: &DVector<f64>,
+    ) -> Result<(DMatrix<f64>, DVector<f64>, Vec<usize>), IdentError> {
         let h: Vec<f64> = theta
             .iter()
             .map(|t| self.settings.fd_step * t.abs())
@@ -255,15 +373,27 @@ impl Problem {
                 thetas.push(t);
             }
         }
-        let sims = self.simulate_many(&thetas)?;
-        let r0 = self.residuals_of(&sims[0]);
+        let sims = self.simulate_each(&thetas);
+        let r0 = self.errors_of(&sims[0].clone()?);
         let mut j = DMatrix::zeros(r0.len(), theta.len());
+        let mut edges = Vec::new();
         for i in 0..theta.len() {
-            let plus = self.residuals_of(&sims[1 + 2 * i]);
-            let minus = self.residuals_of(&sims[2 + 2 * i]);
-            j.set_column(i, &((plus - minus) / (2.0 * h[i])));
+            if sims[1 + 2 * i].is_err() || sims[2 + 2 * i].is_err() {
+                edges.push(i);
+            }
+            // Central difference; one-sided where the other side cannot be simulated (a
+            // neighbour beyond the closed loop's stability limit).
+            let column = match (&sims[1 + 2 * i], &sims[2 + 2 * i]) {
+                (Ok(plus), Ok(minus)) => {
+                    (self.errors_of(plus) - self.errors_of(minus)) / (2.0 * h[i])
+                }
+                (Ok(plus), Err(_)) => (self.errors_of(plus) - &r0) / h[i],
+                (Err(_), Ok(minus)) => (&r0 - self.errors_of(minus)) / h[i],
+                (Err(e), Err(_)) => return Err(e.clone()),
+            };
+            j.set_column(i, &column);
         }
-        Ok((j, r0))
+        Ok((j, r0, edges))
     }
 }
 
@@ -291,7 +421,9 @@ impl Operator for Reduced<'_> {
     type Param = DVector<f64>;
     type Output = DVector<f64>;
     fn apply(&self, theta: &DVector<f64>) -> Result<DVector<f64>, argmin::core::Error> {
-        Ok(self.problem.residuals_at(&self.full(theta))?)
+        Ok(self
+            .problem
+            .trial(self.problem.residuals_at(&self.full(theta)))?)
     }
 }
 
@@ -317,8 +449,23 @@ impl CostFunction for Reduced<'_> {
         let excess = (theta - &clamped).norm_squared() / (hi - lo).powi(2);
         let cost = self
             .problem
-            .residuals_at(&self.full(&clamped))?
+            .trial(self.problem.residuals_at(&self.full(&clamped)))?
             .norm_squared();
         Ok(cost * (1.0 + 1e3 * excess) + 1e3 * excess)
+    }
+}
+
+impl Problem {
+    /// Residuals at a trial point; a point whose simulation fails (an unstable closed loop, a
+    /// pole at a circle frequency) gets infinite residuals: a step there is rejected, not an
+    /// abort. Other errors pass.
+    fn trial(&self, r: Result<DVector<f64>, IdentError>) -> Result<DVector<f64>, IdentError> {
+        match r {
+            Err(IdentError::Simulation { .. }) => {
+                self.unsimulable.fetch_add(1, Ordering::Relaxed);
+                Ok(DVector::from_element(1, f64::INFINITY))
+            }
+            other => other,
+        }
     }
 }

@@ -2,7 +2,10 @@
 //! the report JSON ([`IdentReport`], CONTRACT.md keys) and the identified machine file with its
 //! `[provenance]` table ([`machine_toml`], [`crate::machine::raw::RawProvenance`]).
 
-use super::{IdentResult, Method, Problem, Settings, SolverKind};
+use super::diagnosis::{
+    static_groups, DesignReport, NotIdentifiableReport, StaticGroupReport, ValidationReport,
+};
+use super::{IdentResult, Method, Problem, Settings, SolverKind, StaticTerms};
 use crate::axes::{Direction, Eij, Plane};
 use crate::machine::raw::{RawProvenance, RawProvenanceParameter};
 use crate::machine::stiffness::StiffnessRow;
@@ -114,9 +117,35 @@ pub struct IdentReport {
     /// Iterations of the optimiser.
     #[serde(default)]
     pub iterations: Option<u64>,
+    /// `accepted` (exported) or `refused` (ended on a bound or did not converge: nothing
+    /// exported).
+    #[serde(default)]
+    pub status: Option<String>,
+    /// Why refused.
+    #[serde(default)]
+    pub refusal: Option<String>,
     /// Warnings (also printed on standard error).
     #[serde(default)]
     pub warnings: Vec<String>,
+    /// Notes (static terms not separable, reversal terms added, rejected trial steps).
+    #[serde(default)]
+    pub notes: Vec<String>,
+    /// Trial steps that could not be simulated and were rejected.
+    #[serde(default)]
+    pub rejected_steps: Option<u64>,
+    /// Parameters the tests cannot determine (kept at their start value), and why.
+    #[serde(default)]
+    pub not_identifiable: Vec<NotIdentifiableReport>,
+    /// Static (acceleration-independent) terms fitted with the EIJ, per plane and circle
+    /// centre.
+    #[serde(default)]
+    pub static_terms: Vec<StaticGroupReport>,
+    /// Candidate additional tests ranked by the worst relative standard error they leave.
+    #[serde(default)]
+    pub experiment_design: Option<DesignReport>,
+    /// Hold-out validation (`--validate`).
+    #[serde(default)]
+    pub validation: Option<ValidationReport>,
     /// The settings of the run.
     #[serde(default)]
     pub settings: Option<SettingsReport>,
@@ -172,6 +201,9 @@ pub struct SettingsReport {
     pub fd_step: f64,
     /// Smallest σ used to weight a measured value, µm·s²/m.
     pub sigma_floor_um_s2_per_m: f64,
+    /// Static terms fitted with the EIJ.
+    #[serde(default)]
+    pub static_terms: Option<StaticTerms>,
 }
 
 impl From<&Settings> for SettingsReport {
@@ -188,6 +220,7 @@ impl From<&Settings> for SettingsReport {
             tol_step: s.tol_step,
             fd_step: s.fd_step,
             sigma_floor_um_s2_per_m: s.sigma_floor,
+            static_terms: Some(s.static_terms),
         }
     }
 }
@@ -321,7 +354,30 @@ impl IdentReport {
             residual_std: Some(result.residual_std),
             residuals: Some(result.residuals),
             iterations: Some(result.iterations),
+            status: Some(
+                if result.refusal.is_some() {
+                    "refused"
+                } else {
+                    "accepted"
+                }
+                .into(),
+            ),
+            refusal: result.refusal.as_ref().map(|e| e.to_string()),
             warnings: result.warnings.clone(),
+            notes: result.notes.clone(),
+            rejected_steps: Some(result.rejected_steps),
+            not_identifiable: result
+                .not_identifiable
+                .iter()
+                .map(|n| {
+                    let names: Vec<String> =
+                        result.parameters.iter().map(|p| p.name.clone()).collect();
+                    NotIdentifiableReport::new(n, &names, result.parameters[n.index].initial)
+                })
+                .collect(),
+            static_terms: static_groups(result),
+            experiment_design: result.design.as_ref().map(Into::into),
+            validation: None,
             settings: Some(problem.settings().into()),
             tests,
             stiffness: Some(super::stiffness::identified_table(problem, result).rows),

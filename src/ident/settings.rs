@@ -2,6 +2,7 @@
 //! how measured data are read ([`MeasuredOptions`]), and the fixed thresholds of the method.
 //! How the tests are simulated is [`crate::predict::SimSettings`] (inside [`Settings`]).
 
+use super::statics::StaticTerms;
 use crate::predict::SimSettings;
 
 /// Which optimiser.
@@ -48,6 +49,10 @@ pub struct Settings {
     pub method: Method,
     /// Smallest σ used to weight a measured value, µm·s²/m (1e-3): keeps noise-free data finite.
     pub sigma_floor: f64,
+    /// Static terms fitted with the EIJ ([`StaticTerms::Auto`], see [`super::statics`]).
+    pub static_terms: StaticTerms,
+    /// Rank candidate additional tests after the fit (true; see [`super::design`]).
+    pub design: bool,
 }
 
 impl Default for Settings {
@@ -62,6 +67,8 @@ impl Default for Settings {
             fd_step: 1e-3,
             method: Method::Lm,
             sigma_floor: 1e-3,
+            static_terms: StaticTerms::Auto,
+            design: true,
         }
     }
 }
@@ -103,6 +110,28 @@ impl Default for MeasuredOptions {
 /// A parameter whose Jacobian column norm at the start is below this fraction of the largest
 /// is not seen by the tests: it is kept at its start value and reported not identifiable.
 pub const UNIDENTIFIABLE_COLUMN: f64 = 1e-6;
+
+/// A parameter whose standard error predicted at the start (σ taken at face value) exceeds
+/// this fraction of its value is not determined by the tests: kept at its start value.
+pub const NOT_IDENTIFIABLE_REL_STD_ERR: f64 = 1.0;
+
+/// Singular values of the column-scaled Jacobian below this fraction of the largest are a
+/// combination the tests do not see at all (central differences resolve ~1e-6 of a column).
+pub const DEGENERATE_SINGULAR: f64 = 1e-6;
+
+/// A parameter takes part in a null-space direction when its share of the singular vector is
+/// at least this fraction of the largest share.
+pub const TIE_SHARE: f64 = 0.2;
+
+/// A factor within this fraction of a bound has ended on it (0.010006 against 0.01 has).
+pub const AT_BOUND_REL: f64 = 1e-3;
+
+/// Identified factors outside [this, [`PLAUSIBLE_MAX`]] are implausible for a reduction of
+/// catalogue stiffness (a warning).
+pub const PLAUSIBLE_MIN: f64 = 0.1;
+
+/// A reduction factor above this makes the part stiffer than its catalogue data (a warning).
+pub const PLAUSIBLE_MAX: f64 = 1.0;
 
 /// Singular values of the weighted Jacobian below this fraction of the largest mark a
 /// parameter combination the tests hardly separate (a warning).

@@ -1,8 +1,9 @@
 //! Uncertainty of the identified parameters from one singular value decomposition of the
 //! weighted Jacobian J = ∂r/∂θ at the solution, J = U Σ Vᵀ:
 //!
-//! * covariance cov(θ) = s²·(JᵀJ)⁻¹ = s²·V Σ⁻² Vᵀ with s² = rᵀr/(m − n) (DESIGN.md,
-//!   identification), directions with σ_k below the rank threshold left out;
+//! * covariance cov(θ) = s²·(JᵀJ)⁻¹ = s²·V Σ⁻² Vᵀ with s² = rᵀr/dof (DESIGN.md,
+//!   identification; dof = m − n − q with q static terms eliminated, see
+//!   [`super::statics`]), directions with σ_k below the rank threshold left out;
 //! * correlation cov_ab/√(cov_aa·cov_bb);
 //! * the singular values themselves (how well the tests separate parameter combinations);
 //! * warnings: a near-singular combination, a failed χ² test, a weakly determined parameter.
@@ -21,23 +22,28 @@ pub struct Uncertainty {
     pub correlation: DMatrix<f64>,
     /// Singular values of J, descending.
     pub singular_values: Vec<f64>,
-    /// Residual standard deviation s = √(rᵀr/(m − n)).
+    /// Residual standard deviation s = √(rᵀr/dof).
     pub residual_std: f64,
+    /// Covariance of the free θ = 1/p.
+    pub covariance: DMatrix<f64>,
+    /// Whether the χ² test failed (s ≫ 1).
+    pub chi2_failed: bool,
     /// Warnings, in the order near-singular, χ², weakly determined parameters.
     pub warnings: Vec<String>,
 }
 
 impl Uncertainty {
     /// The uncertainty of the free parameters `theta` (θ = 1/p, named `names`) from the weighted
-    /// Jacobian `j` (m × n) and the cost rᵀr at the solution.
+    /// Jacobian `j` (m × n), the cost rᵀr at the solution and its degrees of freedom.
     pub fn at(
         j: &DMatrix<f64>,
         cost: f64,
         theta: &[f64],
         names: &[&str],
+        dof: usize,
     ) -> Result<Uncertainty, IdentError> {
         let (m, n) = j.shape();
-        let dof = (m - n) as f64;
+        let dof = dof.max(1) as f64;
         let s2 = cost / dof;
         let svd = j
             .clone()
@@ -57,9 +63,10 @@ impl Uncertainty {
             }
         }
         // χ² test of the fit: with honest σ, s² = χ²/(m − n) scatters about 1 by √(2/(m − n)).
-        if s2 > 1.0 + CHI2_SIGMAS * (2.0 / dof).sqrt() {
+        let chi2_failed = s2 > 1.0 + CHI2_SIGMAS * (2.0 / dof).sqrt();
+        if chi2_failed {
             warnings.push(format!(
-                "residual std s = {:.2} ≫ 1: the model cannot reproduce the measured EIJ within their uncertainty (a missing parameter, a model error, or σ too small); standard errors are scaled by s",
+                "χ² test failed: residual std s = {:.2} ≫ 1, the model cannot reproduce the measured EIJ within their uncertainty (a missing parameter, a model error, or σ too small). The standard errors (scaled by s) do not cover such a model error: the identified factors may be off by more than they say",
                 s2.sqrt()
             ));
         }
@@ -97,6 +104,8 @@ impl Uncertainty {
             correlation,
             singular_values,
             residual_std: s2.sqrt(),
+            covariance: cov,
+            chi2_failed,
             warnings,
         })
     }
