@@ -352,7 +352,18 @@ fn a_refused_identification_writes_no_table() {
         let (out, rep, tab) = (s.s("id.toml"), s.s("id.json"), s.s("id.csv"));
         args.extend([out.as_str(), "--report", &rep, "--stiffness-out", &tab]);
         args.extend(extra);
-        let line = one_line_error(&common::eij(&args), &[]);
+        // The fit's warnings (standard error, always), then one line with the diagnosis.
+        let run = common::eij(&args);
+        assert!(!run.status.success());
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        let line = stderr.lines().last().unwrap_or_default();
+        assert!(line.starts_with("eij: error: "), "{stderr}");
+        assert!(
+            stderr
+                .lines()
+                .all(|l| l == line || l.starts_with("warning: ")),
+            "{stderr}"
+        );
         assert!(
             line.contains("did not converge") || line.contains("ended at its bound"),
             "{line}"

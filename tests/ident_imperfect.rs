@@ -160,3 +160,37 @@ fn a_reversal_term_is_added_where_the_data_need_it() {
     assert!(result.notes.iter().any(|n| n.contains("reversal terms")));
     assert_recovered(&result, &TRUTH);
 }
+
+#[test]
+fn a_trial_step_that_cannot_be_simulated_is_rejected_not_fatal() {
+    // The demo data with the catalogue guideways and only the Z screw free: the data want the
+    // screw so soft that the Z drive's closed loop goes unstable (below about 0.09 with its
+    // gains). σ is taken ten times smaller than measured, so that the screw is identifiable
+    // from the start. Trial steps beyond the limit are rejected (not an abort); the fit ends at
+    // the limit and is refused with that diagnosis.
+    let base = common::demo();
+    let mut tests = eij::ident::measured::load(
+        &[common::root().join("measurements/demo-vmc")],
+        &Default::default(),
+    )
+    .unwrap();
+    for t in &mut tests {
+        for v in t.measured.values_mut() {
+            v.1 *= 0.1;
+        }
+    }
+    let params = vec![Parameter::parse("z.screw", &base).unwrap()];
+    let result = run(&base, &params, &tests, StaticTerms::Auto);
+    assert!(result.rejected_steps > 0, "no trial step was unstable");
+    match &result.refusal {
+        Some(eij::ident::IdentError::AtSimulationLimit { names, .. }) => {
+            assert!(names.starts_with("z.screw"), "{names}")
+        }
+        other => panic!("expected a refusal at the simulation limit, got {other:?}"),
+    }
+    assert!(result.parameters[0].value < 0.2 && result.parameters[0].value > 0.05);
+    assert!(result
+        .notes
+        .iter()
+        .any(|n| n.contains("could not be simulated")));
+}
