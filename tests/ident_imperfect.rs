@@ -194,3 +194,133 @@ fn a_trial_step_that_cannot_be_simulated_is_rejected_not_fatal() {
         .iter()
         .any(|n| n.contains("could not be simulated")));
 }
+
+#[test]
+fn nine_factors_with_known_screw_factors_are_recovered() {
+    // The demo machine with the demo's guideway truth and screw factors of its own (the
+    // bundled demo's truth has none), measured as the demo is: two circle centres, three
+    // planes, both directions, 2/5/8 m/s². Noise σ = 0.7 µm (the R-Test's 1.4 µm halved, e.g.
+    // two runs averaged): with 1.4 µm these tests do not determine the Z screw (predicted
+    // standard error 138 % of its value), and identify names it not identifiable instead.
+    let base = common::demo();
+    let truth_values = [
+        ("x.guideway_normal", 0.45),
+        ("x.guideway_lateral", 0.60),
+        ("x.screw", 0.7),
+        ("y.guideway_normal", 0.35),
+        ("y.guideway_lateral", 0.50),
+        ("y.screw", 0.8),
+        ("z.guideway_normal", 0.40),
+        ("z.guideway_lateral", 0.70),
+        ("z.screw", 0.6),
+    ];
+    let (params, truth) = with_factors(&base, &truth_values);
+    let demo_positions = [[150.0, -100.0, 0.0], [-150.0, 100.0, 0.0]];
+    let planned = imperfect::grid(&demo_positions, &Plane::ALL, &[2.0, 5.0, 8.0]);
+    let noisy = |_: Plane, _: [f64; 3]| Imperfections {
+        noise_um: 0.7,
+        ..Default::default()
+    };
+    let tests = imperfect::tests(&truth, &planned, noisy, 700);
+    let result = run(&base, &params, &tests, StaticTerms::Auto);
+    assert_recovered(&result, &truth_values);
+    assert!(result.residual_std < 1.3, "s = {}", result.residual_std);
+}
+
+#[test]
+fn one_plane_names_the_factors_it_cannot_determine_and_ranks_tests_that_would() {
+    // Only the XY circles at one circle centre of the demo data, the six guideway factors:
+    // the Z guideways (tilting the spindle head) are hardly seen in XY. They are named, kept
+    // at their start value and not mistaken for a bound error; the best candidate test is in
+    // another plane.
+    let base = common::demo();
+    let dir = common::root().join("measurements/demo-vmc/pos-a");
+    let files: Vec<std::path::PathBuf> = [
+        "xy_ccw_2", "xy_ccw_5", "xy_ccw_8", "xy_cw_2", "xy_cw_5", "xy_cw_8",
+    ]
+    .iter()
+    .map(|f| dir.join(format!("{f}.csv")))
+    .collect();
+    let tests = eij::ident::measured::load(&files, &Default::default()).unwrap();
+    let problem = Problem::new(
+        base.clone(),
+        Parameter::default_set(&base),
+        tests,
+        Settings::default(),
+    )
+    .unwrap();
+    let result = identify(&problem, None).unwrap();
+    assert!(result.refusal.is_none(), "{:?}", result.refusal);
+    let held: Vec<&str> = result
+        .parameters
+        .iter()
+        .filter(|q| !q.identifiable)
+        .map(|q| q.name.as_str())
+        .collect();
+    assert!(held.iter().any(|n| n.starts_with("z.")), "{held:?}");
+    for q in result.parameters.iter().filter(|q| !q.identifiable) {
+        assert_eq!(q.value, q.initial);
+        assert!(!q.at_bound);
+        assert!(
+            result
+                .warnings
+                .iter()
+                .any(|w| w.starts_with(&format!("{} is not identifiable", q.name))),
+            "{:?}",
+            result.warnings
+        );
+    }
+    assert!(result.warnings.iter().all(|w| !w.contains("bound")));
+    let design = result.design.as_ref().unwrap();
+    let (now, _) = design.worst_now();
+    let best = &design.candidates[0];
+    assert_ne!(best.circle.plane, Plane::Xy);
+    assert!(
+        best.worst_rel_std_err < 0.5 * now,
+        "{} vs {now}",
+        best.worst_rel_std_err
+    );
+}
+
+#[test]
+fn held_out_tests_are_predicted_within_their_uncertainty() {
+    // Fit the demo at 2 and 8 m/s², predict the 5 m/s² circles.
+    let base = common::demo();
+    let root = common::root().join("measurements/demo-vmc");
+    let (mut fit, mut hold) = (Vec::new(), Vec::new());
+    for pos in ["pos-a", "pos-b"] {
+        for plane in ["xy", "yz", "zx"] {
+            for d in ["cw", "ccw"] {
+                for a in ["2", "8"] {
+                    fit.push(root.join(format!("{pos}/{plane}_{d}_{a}.csv")));
+                }
+                hold.push(root.join(format!("{pos}/{plane}_{d}_5.csv")));
+            }
+        }
+    }
+    let load =
+        |f: &[std::path::PathBuf]| eij::ident::measured::load(f, &Default::default()).unwrap();
+    let settings = Settings {
+        design: false,
+        ..Default::default()
+    };
+    let problem = Problem::new(
+        base.clone(),
+        Parameter::default_set(&base),
+        load(&fit),
+        settings.clone(),
+    )
+    .unwrap();
+    let result = identify(&problem, None).unwrap();
+    let v = eij::ident::validation::validate(&result.machine, load(&hold), &settings).unwrap();
+    assert!(v.passed, "χ²/dof = {}", v.chi2_per_dof);
+    assert_eq!(v.tests.len(), 12);
+    assert!(v.tests.iter().all(|t| t.rms_z < 3.0));
+    // The catalogue model does not predict them: the validation can fail.
+    let v0 = eij::ident::validation::validate(&base, load(&hold), &settings).unwrap();
+    assert!(
+        !v0.passed && v0.chi2_per_dof > 100.0,
+        "χ²/dof = {}",
+        v0.chi2_per_dof
+    );
+}
