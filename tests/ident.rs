@@ -18,6 +18,7 @@ fn conditions(planes: &[Plane], accels: &[f64]) -> Vec<TestCase> {
                 circle: CircleTest::new(plane, Direction::Ccw, 2.0, accel_m_s2)
                     .at(vec![0.15, -0.1, 0.0]),
                 measured: Default::default(),
+                clock: None,
             });
         }
     }

@@ -93,7 +93,7 @@ fn static_geometry_on_another_machine_is_fitted_and_the_factors_recovered() {
     // The geometry itself is recovered: every shared term within 3.5 standard errors (36
     // terms) of what was put in.
     let mut worst: f64 = 0.0;
-    for e in &result.static_estimates {
+    for e in result.static_estimates.iter().filter(|e| e.clock.is_none()) {
         let g = &result.statics.groups[e.group];
         let put = geometry(g.plane, [g.position_m[0] * 1e3, 0.0, 0.0]).g_um_per_mm;
         let (a, b) = g.plane.axes();
@@ -109,7 +109,11 @@ fn static_geometry_on_another_machine_is_fitted_and_the_factors_recovered() {
         worst < 3.5,
         "a static term is {worst:.1} standard errors off"
     );
-    assert_eq!(result.static_estimates.len(), 36);
+    assert_eq!(
+        result.static_estimates.len(),
+        36 + 1,
+        "36 geometric terms and one clock"
+    );
     // No reversal terms: the geometry is the same for cw and ccw.
     assert!(result.statics.groups.iter().all(|g| !g.reversal));
 
@@ -322,5 +326,35 @@ fn held_out_tests_are_predicted_within_their_uncertainty() {
         !v0.passed && v0.chi2_per_dof > 100.0,
         "χ²/dof = {}",
         v0.chi2_per_dof
+    );
+}
+
+#[test]
+fn a_probe_logger_lag_is_fitted_not_taken_for_cross_talk() {
+    // The R-Test logger lags the scales by 0.1 ms on top of the geometry: δ·v is 10 µm on a
+    // 2 mm circle at 8 Hz and would pass as antisymmetric in-plane cross-talk of about
+    // 2 µm·s²/m. With cw and ccw in every folder the offset is fitted with the EIJ. (The lag's
+    // second-order term δ²/2·ä biases the in-talk by 10⁶·δ²/2 µm·s²/m — 0.005 here, 0.02 at
+    // 0.2 ms — and is not yet corrected: docs/identification.md.)
+    let base = machine(COLUMN_MILL);
+    let (params, truth) = with_factors(&base, &TRUTH);
+    let planned = imperfect::grid(&POSITIONS_MM, &Plane::ALL, &[2.0, 5.0, 8.0]);
+    let lagging = |plane: Plane, pos: [f64; 3]| Imperfections {
+        lag_s: 0.1e-3,
+        ..geometry(plane, pos)
+    };
+    let tests = imperfect::tests(&truth, &planned, lagging, 900);
+    let result = run(&base, &params, &tests, StaticTerms::Auto);
+    assert_recovered(&result, &TRUTH);
+    let clocks = eij::ident::diagnosis::fitted_clocks(&result);
+    assert_eq!(clocks.len(), 1);
+    let c = &clocks[0];
+    assert!(
+        // Within 3 % (the path's speed is taken as the set speed; this machine's servo radius
+        // errors are about 1 %) plus 3 standard errors.
+        (c.external_late_ms - 0.1).abs() < 0.003 + 3.0 * c.std_err_ms && c.std_err_ms < 0.01,
+        "fitted lag {} ± {} ms, put in 0.1 ms",
+        c.external_late_ms,
+        c.std_err_ms
     );
 }

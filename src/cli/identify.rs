@@ -172,6 +172,8 @@ struct Prepared {
     warnings: Vec<String>,
     /// How measured data were read (validation data are read alike).
     measured_options: MeasuredOptions,
+    /// The clock offsets the evaluation estimated.
+    clocks: Vec<eij::rtest::suite::ClockReport>,
 }
 
 fn prepare(
@@ -199,7 +201,11 @@ fn prepare(
             .map(|n| Parameter::parse(n, &machine))
             .collect::<Result<Vec<_>, _>>()?
     };
-    let (tests, warnings) = measured::load_with_warnings(measured_paths, &mopts)?;
+    let measured::Measured {
+        tests,
+        warnings,
+        clocks,
+    } = measured::load_measured(measured_paths, &mopts)?;
     let problem =
         Problem::new(machine, params, tests, settings).map_err(super::advice::identify)?;
     let provenance = Provenance::now(
@@ -213,6 +219,7 @@ fn prepare(
         problem,
         provenance,
         warnings,
+        clocks,
         measured_options: mopts,
     })
 }
@@ -356,8 +363,10 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
     };
     let mut ident_report = report::IdentReport::new(&prep.problem, &result, &prep.provenance);
     ident_report.validation = validation.as_ref().map(Into::into);
+    ident_report.clocks = prep.clocks.iter().map(Into::into).collect();
     if !args.quiet {
         super::identify_print::print_result(&prep.problem, &result, seconds);
+        super::identify_print::print_clocks(&prep.clocks);
         if let Some(v) = &validation {
             super::identify_print::print_validation(v);
         }

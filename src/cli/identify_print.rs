@@ -104,6 +104,7 @@ pub(super) fn print_result(p: &Problem, result: &IdentResult, seconds: f64) {
         );
     }
     print_statics(result);
+    print_fitted_clocks(result);
     if let Some(d) = &result.design {
         print_design(d);
     }
@@ -122,7 +123,7 @@ fn print_statics(result: &IdentResult) {
         let terms: Vec<String> = result
             .static_estimates
             .iter()
-            .filter(|e| e.group == g)
+            .filter(|e| e.group == g && e.clock.is_none())
             .map(|e| {
                 format!(
                     "{}{} {:+.3} ± {:.3}",
@@ -136,6 +137,23 @@ fn print_statics(result: &IdentResult) {
         if !terms.is_empty() {
             println!("  {:<28} {}", group.label(), terms.join("  "));
         }
+    }
+}
+
+/// The clock offsets fitted with the EIJ.
+fn print_fitted_clocks(result: &IdentResult) {
+    let fitted = eij::ident::diagnosis::fitted_clocks(result);
+    if fitted.is_empty() {
+        return;
+    }
+    println!(
+        "\n  clock offsets fitted with the EIJ (external readings late against the internal ones)"
+    );
+    for c in fitted {
+        println!(
+            "  {:<40} {:+.4} ± {:.4} ms",
+            c.clock, c.external_late_ms, c.std_err_ms
+        );
     }
 }
 
@@ -193,6 +211,29 @@ pub(super) fn print_validation(v: &Validation) {
         println!(
             "  {:<40} {:>5.2}   {:>7.2}   {:>9.4}   {:>6.4}",
             t.label, t.rms_z, t.max_abs_z, t.rms_error_um_s2_per_m, t.rms_sigma_um_s2_per_m
+        );
+    }
+}
+
+/// The clock offsets the evaluation estimated.
+pub(super) fn print_clocks(clocks: &[eij::rtest::suite::ClockReport]) {
+    if clocks.is_empty() {
+        return;
+    }
+    println!(
+        "\n  clock offsets (internal minus external clock; a lagging probe logger is negative)"
+    );
+    for c in clocks {
+        let se = c
+            .std_err_ms
+            .map(|s| format!(" ± {s:.4}"))
+            .unwrap_or_default();
+        println!(
+            "  {:<40} {:+.4}{se} ms  {} tests, {}",
+            c.clock,
+            c.offset_ms,
+            c.tests.len(),
+            if c.applied { "applied" } else { "not applied" }
         );
     }
 }

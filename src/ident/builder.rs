@@ -33,6 +33,7 @@ use std::path::PathBuf;
 ///     source: "synthetic".into(),
 ///     circle,
 ///     measured: values.into_iter().map(|(p, v)| (p, (v, 0.02))).collect(),
+///     clock: None,
 /// });
 ///
 /// let result = Identification::new(machine)

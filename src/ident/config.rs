@@ -41,6 +41,8 @@ pub struct IdentConfig {
     pub static_terms: Option<super::StaticTerms>,
     /// Rank candidate additional tests after the fit.
     pub design: Option<bool>,
+    /// Correct single-file tests by the clock offset the evaluation fits per folder.
+    pub fit_time_offset: Option<bool>,
     /// The file the settings were read from (for messages).
     #[serde(skip)]
     pub source: Option<String>,
@@ -78,6 +80,9 @@ impl IdentConfig {
         }
         if let Some(v) = self.design {
             s.design = v;
+        }
+        if let Some(v) = self.fit_time_offset {
+            m.fit_time_offset = v;
         }
         if let Some(v) = self.max_iters {
             if v == 0 {

@@ -238,7 +238,14 @@ pub fn rank(
             circle.accel_m_s2,
             circle.direction,
         ));
-        let aug = Statics::new(&existing, &all_rows, mode, &reversal);
+        let mut aug = Statics::new(&existing, &all_rows, mode, &reversal);
+        if mode != super::StaticTerms::None {
+            let mut clocks = problem.clock_of();
+            clocks.push("candidate".into());
+            let mut planes: Vec<Plane> = problem.tests().iter().map(|t| t.circle.plane).collect();
+            planes.push(circle.plane);
+            aug = aug.with_clocks(&clocks, &all_rows, &planes);
+        }
         existing.pop();
         let j = DMatrix::from_fn(m + eijs.len(), n, |r, i| {
             if r < m {

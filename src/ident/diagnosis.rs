@@ -96,7 +96,11 @@ pub fn static_groups(result: &IdentResult) -> Vec<StaticGroupReport> {
                 reversal_um_per_mm: BTreeMap::new(),
                 reversal_std_err_um_per_mm: BTreeMap::new(),
             };
-            for e in result.static_estimates.iter().filter(|e| e.group == g) {
+            for e in result
+                .static_estimates
+                .iter()
+                .filter(|e| e.group == g && e.clock.is_none())
+            {
                 let (v, s) = if e.reversal {
                     (&mut r.reversal_um_per_mm, &mut r.reversal_std_err_um_per_mm)
                 } else {
@@ -240,6 +244,71 @@ impl From<&Validation> for ValidationReport {
                     rms_sigma_um_s2_per_m: t.rms_sigma_um_s2_per_m,
                 })
                 .collect(),
+        }
+    }
+}
+
+/// A clock offset fitted with the EIJ (see [`super::statics::Statics::with_clocks`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FittedClockReport {
+    /// The clock (the folder of its files).
+    pub clock: String,
+    /// How late the external (R-Test) readings are against the internal ones, ms.
+    pub external_late_ms: f64,
+    /// Its standard error, ms.
+    pub std_err_ms: f64,
+}
+
+/// The clock offsets fitted with the EIJ.
+pub fn fitted_clocks(result: &IdentResult) -> Vec<FittedClockReport> {
+    result
+        .static_estimates
+        .iter()
+        .filter_map(|e| {
+            e.clock.map(|k| FittedClockReport {
+                clock: result.statics.clocks[k].clone(),
+                external_late_ms: e.value_um_per_mm,
+                std_err_ms: e.std_err_um_per_mm,
+            })
+        })
+        .collect()
+}
+
+/// A clock whose offset the evaluation estimated (CONTRACT.md `time_offset_ms`: internal
+/// clock minus external clock; a probe logger lagging the scales by δ gives −δ).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ClockOffsetReport {
+    /// The clock: a folder, or a folder and its `[[test]]` `clock`.
+    pub clock: String,
+    /// Its tests.
+    pub tests: Vec<String>,
+    /// Two-system recordings (always aligned) rather than single files.
+    pub two_systems: bool,
+    /// The offset, ms.
+    pub time_offset_ms: f64,
+    /// Its standard error, ms.
+    #[serde(default)]
+    pub std_err_ms: Option<f64>,
+    /// Whether the tests separate it from antisymmetric cross-talk.
+    pub separable: bool,
+    /// Whether the tests were corrected by it.
+    pub applied: bool,
+    /// Remarks.
+    #[serde(default)]
+    pub notes: Vec<String>,
+}
+
+impl From<&crate::rtest::suite::ClockReport> for ClockOffsetReport {
+    fn from(c: &crate::rtest::suite::ClockReport) -> Self {
+        ClockOffsetReport {
+            clock: c.clock.clone(),
+            tests: c.tests.clone(),
+            two_systems: c.two_systems,
+            time_offset_ms: c.offset_ms,
+            std_err_ms: c.std_err_ms,
+            separable: c.separable,
+            applied: c.applied,
+            notes: c.notes.clone(),
         }
     }
 }

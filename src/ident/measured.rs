@@ -6,7 +6,7 @@ use super::{IdentError, TestCase};
 use crate::predict::CircleTest;
 use crate::rtest::conditions::Recording;
 use crate::rtest::inputs::{expand_tests, TestInput};
-use crate::rtest::suite::{evaluate_tests, SuiteOptions};
+use crate::rtest::suite::{evaluate_tests, ClockReport, SuiteOptions};
 use crate::rtest::table;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -32,6 +32,25 @@ pub fn load_with_warnings(
     paths: &[PathBuf],
     opts: &MeasuredOptions,
 ) -> Result<(Vec<TestCase>, Vec<String>), IdentError> {
+    let m = load_measured(paths, opts)?;
+    Ok((m.tests, m.warnings))
+}
+
+/// What [`load_measured`] read.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Measured {
+    /// The test cases.
+    pub tests: Vec<TestCase>,
+    /// What the evaluation says about conditions and clocks, naming the test or clock; and,
+    /// with [`MeasuredOptions::fit_time_offset`], which tests' clock offset is not separable.
+    pub warnings: Vec<String>,
+    /// The clocks whose offsets the evaluation estimated (applied to single-file tests with
+    /// [`MeasuredOptions::fit_time_offset`]; two-system recordings are always aligned).
+    pub clocks: Vec<ClockReport>,
+}
+
+/// As [`load`], with warnings and clock offsets.
+pub fn load_measured(paths: &[PathBuf], opts: &MeasuredOptions) -> Result<Measured, IdentError> {
     let inputs = expand_tests(paths)?;
     let (tables, series): (Vec<&TestInput>, Vec<&TestInput>) = inputs
         .iter()
@@ -41,10 +60,28 @@ pub fn load_with_warnings(
         &series,
         &SuiteOptions {
             fallback_radius_mm: Some(opts.radius_mm),
+            fit_time_offset: opts.fit_time_offset,
             ..Default::default()
         },
     )?;
     let mut warnings = suite.warnings;
+    if opts.fit_time_offset {
+        let unseparated: Vec<String> = suite
+            .tests
+            .iter()
+            .filter(|t| t.time_offset.is_none())
+            .map(|t| t.input.name())
+            .collect();
+        if !unseparated.is_empty() {
+            warnings.push(format!(
+                "the clock offset between scales and R-Test is not separable from cross-talk for {} test(s) ({}{}): a probe-logger lag there would pass as antisymmetric in-plane cross-talk (separable with cw and ccw at one acceleration, or three circle speeds, per folder)",
+                unseparated.len(),
+                unseparated.iter().take(3).cloned().collect::<Vec<_>>().join(", "),
+                if unseparated.len() > 3 { ", …" } else { "" }
+            ));
+        }
+    }
+    let clocks = suite.clocks;
     warnings.extend(
         suite
             .tests
@@ -79,9 +116,20 @@ pub fn load_with_warnings(
                 .iter()
                 .map(|(p, v)| (*p, (*v, result.std_err[p])))
                 .collect(),
+            clock: Some(
+                input
+                    .primary_file()
+                    .parent()
+                    .map(|d| d.display().to_string())
+                    .unwrap_or_default(),
+            ),
         });
     }
-    Ok((tests, warnings))
+    Ok(Measured {
+        tests,
+        warnings,
+        clocks,
+    })
 }
 
 /// The tests of an EIJ table, one per plane, direction and acceleration.
@@ -113,6 +161,7 @@ fn table_tests(
                 position_m: position_m.clone(),
             },
             measured: BTreeMap::new(),
+            clock: None,
         });
         case.measured.insert(
             row.parameter,

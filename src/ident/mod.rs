@@ -94,6 +94,9 @@ pub struct StaticEstimate {
     pub eij: crate::axes::Eij,
     /// A reversal term (sign flips with the direction).
     pub reversal: bool,
+    /// A clock offset instead (index into [`Statics::clocks`]): external readings late by
+    /// `value_um_per_mm` ms (± `std_err_um_per_mm`).
+    pub clock: Option<usize>,
     /// Value, µm per mm of set position.
     pub value_um_per_mm: f64,
     /// Standard error, µm/mm.
@@ -481,6 +484,7 @@ pub fn identify(
             group: c.group,
             eij: c.eij,
             reversal: c.reversal,
+            clock: c.clock,
             value_um_per_mm: v,
             std_err_um_per_mm: se,
         })

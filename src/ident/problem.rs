@@ -24,6 +24,9 @@ pub struct TestCase {
     pub circle: CircleTest,
     /// Measured value and standard uncertainty σ per parameter, µm·s²/m.
     pub measured: BTreeMap<Eij, (f64, f64)>,
+    /// The clock it was recorded on (tests sharing one time offset between scales and R-Test,
+    /// e.g. the files of one folder); `None`: its own (a table row group).
+    pub clock: Option<String>,
 }
 
 impl TestCase {
@@ -175,7 +178,25 @@ impl Problem {
                 )
             })
             .collect();
-        Statics::new(&tests, &self.rows, self.settings.static_terms, reversal)
+        let statics = Statics::new(&tests, &self.rows, self.settings.static_terms, reversal);
+        if self.settings.static_terms == super::StaticTerms::None {
+            return statics;
+        }
+        let planes: Vec<_> = self.tests.iter().map(|t| t.circle.plane).collect();
+        statics.with_clocks(&self.clock_of(), &self.rows, &planes)
+    }
+
+    /// The clock of every test: the folder of its file (one R-Test session), `""` for tests
+    /// from memory; EIJ tables have none of their own (each table row group its own).
+    pub fn clock_of(&self) -> Vec<String> {
+        self.tests
+            .iter()
+            .enumerate()
+            .map(|(i, t)| match &t.clock {
+                Some(c) => c.clone(),
+                None => format!("#{i}"),
+            })
+            .collect()
     }
 
     /// The same problem with other static terms.

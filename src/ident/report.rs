@@ -3,7 +3,8 @@
 //! `[provenance]` table ([`machine_toml`], [`crate::machine::raw::RawProvenance`]).
 
 use super::diagnosis::{
-    static_groups, DesignReport, NotIdentifiableReport, StaticGroupReport, ValidationReport,
+    fitted_clocks, static_groups, ClockOffsetReport, DesignReport, FittedClockReport,
+    NotIdentifiableReport, StaticGroupReport, ValidationReport,
 };
 use super::{IdentResult, Method, Problem, Settings, SolverKind, StaticTerms};
 use crate::axes::{Direction, Eij, Plane};
@@ -146,6 +147,13 @@ pub struct IdentReport {
     /// Hold-out validation (`--validate`).
     #[serde(default)]
     pub validation: Option<ValidationReport>,
+    /// Clock offsets between scales and R-Test estimated by the evaluation (applied with the
+    /// setting `fit_time_offset`).
+    #[serde(default)]
+    pub clocks: Vec<ClockOffsetReport>,
+    /// Clock offsets fitted jointly with the EIJ (per folder with both directions).
+    #[serde(default)]
+    pub clock_offsets: Vec<FittedClockReport>,
     /// The settings of the run.
     #[serde(default)]
     pub settings: Option<SettingsReport>,
@@ -378,6 +386,8 @@ impl IdentReport {
             static_terms: static_groups(result),
             experiment_design: result.design.as_ref().map(Into::into),
             validation: None,
+            clocks: Vec::new(),
+            clock_offsets: fitted_clocks(result),
             settings: Some(problem.settings().into()),
             tests,
             stiffness: Some(super::stiffness::identified_table(problem, result).rows),

@@ -96,6 +96,13 @@ pub struct MeasuredOptions {
     pub radius_mm: f64,
     /// σ for table values without a standard error, µm·s²/m (0.05).
     pub table_std_err: f64,
+    /// Correct single-file tests by the clock offset (probe-logger lag) that the evaluation
+    /// fits over the tests of their folder where the tests separate it from cross-talk (false;
+    /// [`crate::rtest::clock_fit`]; the offsets are reported either way). Off by default: the
+    /// evaluation's fit takes EIJ as equal for cw and ccw, so it also absorbs the structural
+    /// deviation proportional to velocity (damping) that the model predicts and that flips with
+    /// the direction like δ·v does (0.4 µs on the demo data, which have no lag).
+    pub fit_time_offset: bool,
 }
 
 impl Default for MeasuredOptions {
@@ -103,6 +110,7 @@ impl Default for MeasuredOptions {
         MeasuredOptions {
             radius_mm: 2.0,
             table_std_err: 0.05,
+            fit_time_offset: false,
         }
     }
 }

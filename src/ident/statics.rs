@@ -118,6 +118,9 @@ pub struct StaticColumn {
     pub eij: Eij,
     /// A reversal term (flips sign with the direction) rather than a shared one.
     pub reversal: bool,
+    /// A clock offset (index into [`Statics::clocks`]) rather than a geometric term; `group`
+    /// and `eij` then mean nothing.
+    pub clock: Option<usize>,
 }
 
 /// The static terms of a problem and the projection that eliminates them.
@@ -127,6 +130,9 @@ pub struct Statics {
     pub groups: Vec<StaticGroup>,
     /// The terms, in the order of A's columns.
     pub columns: Vec<StaticColumn>,
+    /// The clocks (tests sharing one time offset between scales and R-Test, e.g. one folder)
+    /// with a fitted offset.
+    pub clocks: Vec<String>,
     /// A, m × q (weighted like the residuals).
     a: DMatrix<f64>,
     /// Orthonormal basis of A's column space, m × rank.
@@ -218,6 +224,7 @@ impl Statics {
                         group: k,
                         eij,
                         reversal,
+                        clock: None,
                     }));
                 }
             }
@@ -246,10 +253,75 @@ impl Statics {
         Statics {
             groups,
             columns,
+            clocks: Vec::new(),
             a,
             basis,
             pinv,
         }
+    }
+
+    /// Adds a clock-offset term per clock whose tests hold both directions (`clock_of[test]`
+    /// names each test's clock; see the module docs): external readings late by δ (ms) shift
+    /// the cross-talk of plane (a, b) by Ê_ab += 10³·δ/ω, Ê_ba −= 10³·δ/ω (ω signed, rad/s;
+    /// [`crate::rtest::clock_fit`]), so the column's entries are ∓10³/(ωσ) in those rows. The
+    /// path's speed is taken as the set speed (ρ = r): a servo radius error of 1 % scales δ by
+    /// 1 %.
+    /// A velocity-proportional structural deviation (damping) has the same shape, but the model
+    /// predicts it, so only a true offset is left for δ.
+    pub fn with_clocks(mut self, clock_of: &[String], rows: &[Row], planes: &[Plane]) -> Statics {
+        let mut names: Vec<String> = clock_of.to_vec();
+        names.sort();
+        names.dedup();
+        for name in names {
+            let tests: Vec<usize> = (0..clock_of.len())
+                .filter(|&t| clock_of[t] == name)
+                .collect();
+            let dirs = |d: Direction| {
+                rows.iter()
+                    .any(|r| tests.contains(&r.test) && r.direction == d)
+            };
+            if !(dirs(Direction::Cw) && dirs(Direction::Ccw)) {
+                continue;
+            }
+            let k = self.clocks.len();
+            self.clocks.push(name);
+            self.columns.push(StaticColumn {
+                group: 0,
+                eij: rows
+                    .first()
+                    .map(|r| r.eij)
+                    .unwrap_or(Eij::new(crate::axes::Axis::X, crate::axes::Axis::X)),
+                reversal: false,
+                clock: Some(k),
+            });
+            let col = DVector::from_iterator(
+                rows.len(),
+                rows.iter().map(|r| {
+                    if !tests.contains(&r.test) {
+                        return 0.0;
+                    }
+                    let (a, b) = planes[r.test].axes();
+                    let s = if r.eij == Eij::new(a, b) {
+                        1.0
+                    } else if r.eij == Eij::new(b, a) {
+                        -1.0
+                    } else {
+                        return 0.0;
+                    };
+                    // 1/ω = sgn·√(r/a), r in m.
+                    let inv_omega = r.direction.sign() * (r.r_over_a * 1e-3).sqrt();
+                    // The residual is model − measurement: the measured shift enters with −.
+                    -s * 1e3 * inv_omega / r.sigma
+                }),
+            );
+            self.a = self.a.clone().insert_column(self.a.ncols(), 0.0);
+            let last = self.a.ncols() - 1;
+            self.a.set_column(last, &col);
+        }
+        let (basis, pinv) = decompose(&self.a);
+        self.basis = basis;
+        self.pinv = pinv;
+        self
     }
 
     /// Number of static terms q.

@@ -158,6 +158,7 @@ pub fn tests(
                     .iter()
                     .map(|(p, v)| (*p, (*v, r.std_err[p])))
                     .collect(),
+                clock: Some("generated".into()),
             }
         })
         .collect()
