@@ -328,3 +328,39 @@ fn default_outputs_are_named_after_the_machine() {
     assert!(s.path("out/mymill-identify-report.json").is_file());
     assert!(!s.path("out/demo-vmc-identified.toml").exists());
 }
+
+#[test]
+fn a_file_without_its_set_radius_says_which_radius_was_assumed() {
+    // A lone file (no rtest.toml beside it): identify takes its config radius (2 mm by default)
+    // as the set radius and says so, with the data's own mean internal radius beside it.
+    let s = Scratch::new("radius-fallback");
+    let file = s.path("zx_ccw_5.csv");
+    std::fs::copy(
+        root().join("measurements/demo-vmc/pos-a/zx_ccw_5.csv"),
+        &file,
+    )
+    .unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_eij"))
+        .current_dir(root())
+        .args([
+            "identify",
+            "--quiet",
+            "--no-design",
+            "--param",
+            "z.guideway_normal",
+        ])
+        .args(["--position-mm", "150,-100,0", "--measured"])
+        .arg(&file)
+        .arg("--out")
+        .arg(s.path("id.toml"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("no set radius in the test's conditions")
+            && stderr.contains("radius 2.0000 mm")
+            && stderr.contains("mean internal radius is 1.9"),
+        "{stderr}"
+    );
+}

@@ -53,6 +53,33 @@ fn demo_machine_is_accepted() {
 }
 
 #[test]
+fn a_nest_away_from_the_tool_is_refused() {
+    // The R-Test nest is set up under the tool: a workpiece point elsewhere contradicts it.
+    let t = demo_text().replace(
+        "body = \"table\"\npoint_m = [0.0, 0.0, 0.05]",
+        "body = \"table\"\npoint_m = [0.1, 0.0, 0.05]",
+    );
+    assert_ne!(t, demo_text());
+    assert_one_line_error(
+        "nest_away",
+        &t,
+        &[
+            "workpiece.point_m",
+            "not the TCP at the reference position",
+            "under the tool",
+        ],
+    );
+    // Without the point the file means the same machine.
+    let t = demo_text().replace(
+        "body = \"table\"\npoint_m = [0.0, 0.0, 0.05]\n",
+        "body = \"table\"\n",
+    );
+    assert_ne!(t, demo_text());
+    let (ok, stderr, wrote) = run_with_machine("nest_implied", &t, &["export"]);
+    assert!(ok && wrote, "{stderr}");
+}
+
+#[test]
 fn zero_and_negative_mass() {
     let t = demo_text().replace("mass_kg = 450.0", "mass_kg = 0.0");
     assert_one_line_error("zero-mass", &t, &["body[table].mass_kg", "must be > 0"]);

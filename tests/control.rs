@@ -14,7 +14,8 @@ use common::machine as load;
 
 /// The following error X_set − X per unit set position of `machines/reference/single-axis.toml`
 /// at s = jω, derived by hand in the Laplace domain. The slide's x and the rotor angle Φ
-/// decouple from the other DOF (nut and scale on the COG line, no carriage stiffness along x):
+/// decouple from the other DOF (nut and scale on the COG line, no carriage stiffness along x)
+/// but for the thread torque on the slide's roll, which softens k̃ (see below):
 ///
 /// ```text
 /// m s² X = −k̃ δ,  δ = X − h'Φ,  k̃ = k_ax + c_s s                (slide on the screw)
@@ -33,7 +34,19 @@ fn hand_following_error(omega: f64) -> Complex<f64> {
     let (c_s, c_f) = (4.0e3, 0.01);
     let (kv, kp, tn, tc, kvff, kaff) = (40.0, 2.0, 0.01, 0.0004, 0.9, 0.8);
     let j_eq = j + m * hp * hp;
+    // The right-hand thread turns the nut's axial force into a torque on the slide's roll a
+    // (δ = X − h'(Φ + a)); the roll, coupled with y by the carriages below the COG, answers
+    // with a = H_aa·h'·k̃·δ, so the screw acts as k̃ in series with the roll: k̃/(1 + h'²k̃H_aa).
+    let (kc, cc) = (
+        Complex::new(5e8, 0.0) + 2e3 * s,
+        Complex::new(5e8, 0.0) + 2e3 * s,
+    );
+    let z_yy = 4.0 * kc + 500.0 * s * s;
+    let z_ya = 4.0 * kc * 0.2;
+    let z_aa = 4.0 * kc * 0.04 + 4.0 * cc * 0.0625 + 20.0 * s * s;
+    let h_aa = z_yy / (z_yy * z_aa - z_ya * z_ya);
     let kt = k_ax + c_s * s;
+    let kt = kt / (1.0 + hp * hp * kt * h_aa);
     let g = kt * hp / (m * s * s + kt);
     let one = Complex::new(1.0, 0.0);
     let p = kp * (one + one / (tn * s)) / (one + tc * s);

@@ -1,5 +1,6 @@
 //! Multi-body assembly and modal analysis against hand calculations and physical identities.
 
+use eij::machine::catalogue::Catalogue;
 use eij::machine::Machine;
 use eij::mbs::{modal, MbsError, Model};
 
@@ -53,24 +54,74 @@ fn single_body_on_four_supports_matches_hand_calculation() {
     );
 }
 
+/// The single-axis slide's x, y, roll a and rotor φ by hand (z, b, c do not couple with them:
+/// the nut lies on the line through the COG and the rails are symmetric about it). Carriages at
+/// (±0.3, ±0.25, 0), COG at z = 0.2: a carriage moves by u_y = y + 0.2·a laterally and
+/// u_z = z ± 0.25·a normally; the screw spring strains by δ = x − (φ + a)·h/(2π) (right-hand
+/// thread: the nut turning with the slide's roll moves along the screw). Returns ω² of
+/// K v = ω² M v, ascending, rigid drive mode first.
+fn slide_hand_omega2(k_ax: f64) -> Vec<f64> {
+    let (kc, h) = (5e8, 0.02 / std::f64::consts::TAU);
+    // DOF order x, y, a, φ.
+    let mut k = nalgebra::Matrix4::<f64>::zeros();
+    k[(1, 1)] = 4.0 * kc;
+    k[(1, 2)] = 4.0 * kc * 0.2;
+    k[(2, 1)] = 4.0 * kc * 0.2;
+    k[(2, 2)] = 4.0 * kc * 0.04 + 4.0 * kc * 0.0625;
+    let g = nalgebra::Vector4::new(1.0, 0.0, -h, -h);
+    k += g * g.transpose() * k_ax;
+    let m_inv_sqrt = nalgebra::Vector4::new(500.0, 500.0, 20.0, 0.004).map(|m: f64| 1.0 / m.sqrt());
+    let a = nalgebra::Matrix4::from_diagonal(&m_inv_sqrt)
+        * k
+        * nalgebra::Matrix4::from_diagonal(&m_inv_sqrt);
+    let mut w2: Vec<f64> = a.symmetric_eigenvalues().iter().copied().collect();
+    w2.sort_by(f64::total_cmp);
+    w2
+}
+
+fn hz(omega2: f64) -> f64 {
+    omega2.max(0.0).sqrt() / std::f64::consts::TAU
+}
+
+/// Total axial stiffness of the single-axis screw with the nut at l₁ from the bearing.
+fn single_axis_k_ax(l1: f64) -> f64 {
+    let k_shaft = 2.1e11 * std::f64::consts::PI * 0.03 * 0.03 / 4.0 / l1;
+    1.0 / (1.0 / k_shaft + 1.0 / 1e9 + 1.0 / 1e9)
+}
+
 #[test]
 fn single_axis_slide_on_carriages_and_screw_matches_hand_calculation() {
     let machine = load("reference/single-axis.toml");
     let f = frequencies(&machine, &[0.0]);
     assert_eq!(f.len(), 7);
     assert_eq!(f[0], 0.0, "the drive's own rigid-body mode");
-    // Axial mode of slide and rotor on the screw spring, by hand.
-    let (e, d, l1) = (2.1e11, 0.03, 0.5);
-    let k_shaft = e * std::f64::consts::PI * d * d / 4.0 / l1;
-    let k_ax = 1.0 / (1.0 / k_shaft + 1.0 / 1e9 + 1.0 / 1e9);
-    let m_r = 0.004 * (std::f64::consts::TAU / 0.02_f64).powi(2);
-    let axial = (k_ax * (1.0 / 500.0 + 1.0 / m_r)).sqrt() / std::f64::consts::TAU;
-    let mut want: Vec<f64> = FOUR_SUPPORTS_HZ[1..].to_vec();
-    want.push(axial);
+    let hand = slide_hand_omega2(single_axis_k_ax(0.5));
+    assert!(
+        hand[0].abs() < 1e-6 * hand[3],
+        "hand drive mode {}",
+        hand[0]
+    );
+    // z, b, c from four-joints.toml (318, 390, 427 Hz); x, y, a and the rotor from the 4-DOF
+    // hand model.
+    let mut want: Vec<f64> = FOUR_SUPPORTS_HZ[2..5].to_vec();
+    want.extend(hand[1..].iter().map(|w| hz(*w)));
     want.sort_by(f64::total_cmp);
     for (got, want) in f[1..].iter().zip(&want) {
         assert_rel(*got, *want, 1e-6);
     }
+    // Without the thread torque the axial mode would be √(k_ax(1/m + 1/m_r)): the torque
+    // couples it with the roll and moves it by about 1e-5 — more than the tolerance above.
+    let m_r = 0.004 * (std::f64::consts::TAU / 0.02_f64).powi(2);
+    let no_torque = hz(single_axis_k_ax(0.5) * (1.0 / 500.0 + 1.0 / m_r));
+    let axial = f
+        .iter()
+        .copied()
+        .min_by(|a, b| (a - no_torque).abs().total_cmp(&(b - no_torque).abs()))
+        .unwrap();
+    assert!(
+        ((axial - no_torque) / no_torque).abs() > 5e-6,
+        "{axial} vs {no_torque}"
+    );
 }
 
 #[test]
@@ -85,10 +136,16 @@ fn screw_stiffness_follows_the_nut_position() {
             .find(|m| m.frequency_hz > 0.0 && m.dominant_dof == "x.motor")
             .unwrap();
         let l1 = 0.5 + s; // tool side: the slide moves +s along x
-        let k_shaft = 2.1e11 * std::f64::consts::PI * 0.03 * 0.03 / 4.0 / l1;
-        let k_ax = 1.0 / (1.0 / k_shaft + 2.0 / 1e9);
-        let m_r = 0.004 * (std::f64::consts::TAU / 0.02_f64).powi(2);
-        let want = (k_ax * (1.0 / 500.0 + 1.0 / m_r)).sqrt() / std::f64::consts::TAU;
+        let hand = slide_hand_omega2(single_axis_k_ax(l1));
+        let want = hand[1..]
+            .iter()
+            .map(|w| hz(*w))
+            .min_by(|a, b| {
+                (a - axial.frequency_hz)
+                    .abs()
+                    .total_cmp(&(b - axial.frequency_hz).abs())
+            })
+            .unwrap();
         assert_rel(axial.frequency_hz, want, 1e-6);
     }
 }
@@ -137,7 +194,9 @@ fn frequencies_do_not_change_when_the_whole_machine_is_shifted() {
     let d = [0.7, -1.3, 2.1];
     let shift = |p: &mut [f64; 3]| (0..3).for_each(|i| p[i] += d[i]);
     shift(&mut raw.tcp.point_m);
-    shift(&mut raw.workpiece.point_m);
+    if let Some(p) = raw.workpiece.point_m.as_mut() {
+        shift(p);
+    }
     for b in &mut raw.bodies {
         if let Some(c) = b.cog_m.as_mut() {
             shift(c);
@@ -232,4 +291,113 @@ fn pose_outside_the_stroke_is_refused() {
             .contains("axis z position 0.31 m is outside the stroke"),
         "{err}"
     );
+}
+
+#[test]
+fn screw_force_on_the_nut_comes_with_the_thread_torque() {
+    // Turn the rotor of the single-axis slide by φ₀ with everything else held: the screw spring
+    // pushes the nut with F = k_ax·φ₀·h/(2π) along +x, and the right-hand thread adds the torque
+    // −F·h/(2π) about x on the slide (its reaction is on the ground). The nut lies on the line
+    // through the COG, so the slide sees no other moment. Hand numbers from the machine file.
+    let machine = load("reference/single-axis.toml");
+    let model = Model::assemble(&machine, &[0.0]).unwrap();
+    let h = 0.02 / std::f64::consts::TAU;
+    let k_shaft = 2.1e11 * std::f64::consts::PI * 0.03 * 0.03 / 4.0 / 0.5;
+    let k_ax = 1.0 / (1.0 / k_shaft + 2.0 / 1e9);
+    let phi0 = 1e-3;
+    let mut q = nalgebra::DVector::zeros(model.n_dof());
+    q[model.axes[0].rotor_dof] = phi0;
+    let f = -(&model.stiffness * &q);
+    let force = k_ax * phi0 * h;
+    assert_rel(f[0], force, 1e-12);
+    assert!(f[1].abs() < 1e-9 * force && f[2].abs() < 1e-9 * force);
+    assert_rel(f[3], -force * h, 1e-12);
+    assert!(f[4].abs() < 1e-9 * force && f[5].abs() < 1e-9 * force);
+    // On the rotor: the screw's reaction −F·h/(2π).
+    assert_rel(f[model.axes[0].rotor_dof], -force * h, 1e-12);
+}
+
+/// The rigid motion of every free body together, as a small rotation `rot` about the point `o`
+/// plus a translation `tr` (rotors held relative to their carriers).
+fn whole_machine_motion(
+    machine: &Machine,
+    model: &Model,
+    pose: &[f64],
+    tr: nalgebra::Vector3<f64>,
+    rot: nalgebra::Vector3<f64>,
+    o: nalgebra::Vector3<f64>,
+) -> nalgebra::DVector<f64> {
+    let mut v = nalgebra::DVector::zeros(model.n_dof());
+    let mut i = 0;
+    for (b, body) in machine.bodies.iter().enumerate() {
+        if body.fixed {
+            continue;
+        }
+        // The body's COG at this pose: shifted by every axis that carries it.
+        let mut c = body.cog_m;
+        for (ai, a) in machine.axes.iter().enumerate() {
+            if machine.is_carried_by(b, ai) {
+                c += a.direction() * (a.side.sign() * (pose[ai] - a.reference_m));
+            }
+        }
+        let u = tr + rot.cross(&(c - o));
+        for d in 0..3 {
+            v[i + d] = u[d];
+            v[i + 3 + d] = rot[d];
+        }
+        i += 6;
+    }
+    v
+}
+
+#[test]
+fn a_rigid_motion_of_the_whole_machine_is_neither_deviation_nor_scale_reading() {
+    // The nest is set up under the tool at every circle centre, so rocking the whole machine on
+    // its feet moves TCP and nest together: no deviation, no scale reading, no screw strain, at
+    // the reference and far from it.
+    let machine = load("demo-vmc.toml");
+    let mut raw = machine.to_raw();
+    raw.joints.clear();
+    let on_no_feet =
+        Machine::from_raw(raw, &Catalogue::bundled().unwrap(), "demo without feet").unwrap();
+    for pose in [
+        [0.0, 0.0, 0.0],
+        [0.15, -0.1, 0.0],
+        [-0.3, 0.25, -0.1],
+        [0.3, 0.25, 0.3],
+    ] {
+        let model = Model::assemble(&machine, &pose).unwrap();
+        let floating = Model::assemble(&on_no_feet, &pose).unwrap();
+        for (tr, rot) in [
+            ([1e-6, -2e-6, 3e-6], [0.0, 0.0, 0.0]),
+            ([0.0, 0.0, 0.0], [1e-6, 0.0, 0.0]),
+            ([0.0, 0.0, 0.0], [0.0, 1e-6, 0.0]),
+            ([0.0, 0.0, 0.0], [0.0, 0.0, 1e-6]),
+        ] {
+            let v = whole_machine_motion(
+                &machine,
+                &model,
+                &pose,
+                tr.into(),
+                rot.into(),
+                nalgebra::Vector3::new(0.4, -0.7, -0.9),
+            );
+            let tcp = &model.tcp * &v;
+            assert!(
+                tcp.norm() < 1e-18,
+                "pose {pose:?}: TCP − nest moves by {tcp}"
+            );
+            for (a, p) in model.axes.iter().enumerate() {
+                let s = p.scale.dot(&v);
+                assert!(s.abs() < 1e-18, "pose {pose:?}: scale {a} reads {s}");
+            }
+            // Only the feet strain: without them the same motion strains nothing.
+            let k_free = &floating.stiffness * &v;
+            assert!(
+                k_free.amax() < 1e-9 * floating.stiffness.amax() * 1e-6,
+                "pose {pose:?}: a rigid motion strains the machine: {}",
+                k_free.amax()
+            );
+        }
+    }
 }

@@ -160,7 +160,9 @@ fn segments(
     (0..n)
         .map(|j| {
             let mut pose = machine.reference_pose();
-            pose[0] += mv.distance_m * (j as f64 + 0.5) / n as f64;
+            let mut set_position_m = vec![0.0; pose.len()];
+            set_position_m[0] = mv.distance_m * (j as f64 + 0.5) / n as f64;
+            pose[0] += set_position_m[0];
             let closed_loop = ClosedLoop::new(machine, &pose).unwrap();
             let discrete = eij::sim::Discrete::new(&closed_loop, 1.0 / rate);
             let from_s = if j == 0 {
@@ -172,6 +174,7 @@ fn segments(
                 from_s,
                 closed_loop,
                 discrete,
+                set_position_m,
             }
         })
         .collect()
@@ -186,12 +189,27 @@ fn long_moves_are_reassembled_along_the_path() {
     let segs =
         eij::sim::move_segments(&machine, &machine.reference_pose(), 0, &short, rate).unwrap();
     assert_eq!(segs.len(), 1);
+    // Only the TCP outputs differ: along the move they follow the point of the workpiece under
+    // the tool, which at rest (no deformation) is no difference at all.
     let a = eij::sim::simulate_segments(&segs, &short).unwrap();
     let b = simulate(&segs[0].closed_loop, &short, rate).unwrap();
-    assert_eq!(a.outputs, b.outputs);
+    let cl = &segs[0].closed_loop;
+    let tcp: Vec<usize> = ["x_tcp_m", "y_tcp_m", "z_tcp_m"]
+        .iter()
+        .map(|o| cl.output(o).unwrap())
+        .collect();
+    for (k, (ya, yb)) in a.outputs.iter().zip(&b.outputs).enumerate() {
+        if tcp.contains(&(k % a.ny)) {
+            if k < a.ny {
+                assert!((ya - yb).abs() < 1e-18, "output {k} at rest: {ya} vs {yb}");
+            }
+        } else {
+            assert_eq!(ya, yb, "output {}", k % a.ny);
+        }
+    }
 
     // 0.25 m of X travel: 25 stretches of 10 mm. The deviation (external − internal) in z under
-    // the X acceleration, whose lever arm grows with X, agrees with 125 stretches of 2 mm far
+    // the X acceleration, which changes as the table travels over the saddle, agrees with 125 stretches of 2 mm far
     // better than 5 stretches of 50 mm or one assembly at the middle do.
     let long = JerkLimitedMove::new(Axis::X, 0.25, 0.5, 5.0, 100.0);
     let segs =
@@ -231,15 +249,17 @@ fn long_moves_are_reassembled_along_the_path() {
         err_coarse < err_single,
         "50 mm {err_coarse:e}, single assembly {err_single:e}"
     );
-    // Measured: 50 mm → 10 % of the deviation amplitude, 10 mm → 4.6 %: each switch also
-    // releases the elastic force that the stiffness change leaves over, so the discrepancy
-    // falls slower than the stretch length.
+    // Measured (nest under the tool, followed along the move): one assembly misses the whole
+    // change of the deviation (99 % of its amplitude), 50 mm stretches 20 %, 10 mm 6.8 %, 5 mm
+    // 4.9 %: each switch also releases the elastic force that the stiffness change leaves over,
+    // so the discrepancy falls slower than the stretch length. 10 mm leaves 0.05 µm, far below
+    // the R-Test's 1.4 µm.
     assert!(
         err_rule < 0.5 * err_coarse,
         "10 mm rule {err_rule:e}, 50 mm {err_coarse:e}"
     );
     assert!(
-        err_rule < 0.05 * amplitude,
+        err_rule < 0.08 * amplitude && err_rule < 1e-7,
         "10 mm rule {err_rule:e} vs amplitude {amplitude:e}"
     );
     // The move still arrives.

@@ -208,7 +208,7 @@ fn run_move(common: &Common, mv: &JerkLimitedMove) -> anyhow::Result<()> {
             hi * 1e3
         );
     }
-    // Re-assembled every 50 mm of travel (eij::sim::move_segments).
+    // Re-assembled every 10 mm of travel (eij::sim::move_segments).
     let rate = positive("rate-hz", common.rate_hz)?;
     let segments = eij::sim::move_segments(&machine, &pose, i, mv, rate)?;
     let cond = conditions(common, &machine, &pose);

@@ -264,7 +264,10 @@ pub struct Machine {
     pub bodies: Vec<Body>,
     /// TCP on the tool-side body.
     pub tcp: BodyPoint,
-    /// Workpiece point on the workpiece-side body.
+    /// The R-Test nest on the workpiece-side body at the reference position: the point that
+    /// coincides with the TCP there. At any other axis position the nest is again the point of
+    /// the workpiece body under the TCP (the nest is set up under the tool at each circle centre),
+    /// so a rigid motion of the whole machine never shows as a deviation.
     pub workpiece: BodyPoint,
     /// Linear axes.
     pub axes: Vec<LinearAxis>,
@@ -274,6 +277,9 @@ pub struct Machine {
     pub moved_by: Vec<Option<usize>>,
     raw: RawMachine,
 }
+
+/// How far a given `workpiece.point_m` may lie from the TCP at the reference position, m.
+const NEST_TOLERANCE_M: f64 = 1e-6;
 
 fn finite3(v: [f64; 3]) -> bool {
     v.iter().all(|x| x.is_finite())
@@ -401,7 +407,26 @@ impl Machine {
             })
         };
         let tcp = point(&raw.tcp, "tcp")?;
-        let workpiece = point(&raw.workpiece, "workpiece")?;
+        let workpiece = BodyPoint {
+            body: body_index(&raw.workpiece.body, "workpiece.body".into())?,
+            point_m: tcp.point_m,
+        };
+        if let Some(p) = raw.workpiece.point_m {
+            let given = Vector3::from(p);
+            if !finite3(p) {
+                return Err(err("workpiece.point_m".into(), "must be finite".into()));
+            }
+            if (given - tcp.point_m).norm() > NEST_TOLERANCE_M {
+                return Err(err(
+                    "workpiece.point_m".into(),
+                    format!(
+                        "[{}, {}, {}] m is not the TCP at the reference position [{}, {}, {}] m: \
+                         the R-Test nest is set up under the tool (omit point_m)",
+                        p[0], p[1], p[2], tcp.point_m.x, tcp.point_m.y, tcp.point_m.z
+                    ),
+                ));
+            }
+        }
 
         let mut axes: Vec<LinearAxis> = Vec::with_capacity(raw.axes.len());
         let mut moved_by = vec![None; bodies.len()];

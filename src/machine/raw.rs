@@ -37,8 +37,9 @@ pub struct RawMachine {
     pub provenance: Option<RawProvenance>,
     /// Tool centre point: a point of the tool-side body.
     pub tcp: RawBodyPoint,
-    /// Workpiece point (R-Test nest): a point of the workpiece-side body.
-    pub workpiece: RawBodyPoint,
+    /// Workpiece side of the R-Test: the body that carries the nest. The nest is set up under the
+    /// tool, so its point is the TCP at the reference position; `point_m`, if given, must say so.
+    pub workpiece: RawWorkpiece,
     /// Rigid bodies.
     #[serde(rename = "body")]
     pub bodies: Vec<RawBody>,
@@ -58,6 +59,19 @@ pub struct RawBodyPoint {
     pub body: String,
     /// Point, m.
     pub point_m: [f64; 3],
+}
+
+/// The workpiece body (R-Test nest carrier). The nest sits under the tool at every test's circle
+/// centre, so the point is not free: if `point_m` is given it must coincide with the TCP at the
+/// reference position (it is accepted for files written before the nest moved with the tool).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawWorkpiece {
+    /// Body name.
+    pub body: String,
+    /// Nest point at the reference position, m: the TCP there (optional).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub point_m: Option<[f64; 3]>,
 }
 
 /// A rigid body.

@@ -8,8 +8,10 @@
 //!   coincident point of the carrier, stiff across the rail (normal n, lateral l), free along it:
 //!   K += Gᵀ k G with G = [T_moving(p), −T_carrier(p)] and k = k_n·nnᵀ + k_l·llᵀ.
 //! * The ball screw is an axial spring between the nut point of the moving body and the screw,
-//!   whose axial position is φ·h/(2π): δ = eᵀ(u_moving(p_nut) − u_carrier(p_nut)) − φ·h/(2π),
-//!   K += k_ax·g gᵀ. The drive force acts along the screw line, offset from the centre of gravity:
+//!   whose axial position is φ·h/(2π): δ = eᵀ(u_moving(p_nut) − u_carrier(p_nut))
+//!   − (φ + eᵀ(θ_moving − θ_carrier))·h/(2π), K += k_ax·g gᵀ (right-hand thread, φ the rotor
+//!   angle relative to the carrier): the screw force F on the nut comes with the torque
+//!   −F·h/(2π) about e on the moving body and its reaction on the carrier. The drive force acts along the screw line, offset from the centre of gravity:
 //!   accelerating the axis tilts the slide — the acceleration correlated error eij is about.
 //! * Position dependence: at axis position s every body carried by the axis is shifted by
 //!   σ·(s − s_ref)·e (σ = +1 tool side, −1 workpiece side, ISO 841), which moves the carriage
@@ -99,7 +101,13 @@ pub struct Model {
     /// Per axis (machine order).
     pub axes: Vec<AxisPorts>,
     /// TCP displacement relative to the workpiece point in machine coordinates: `tcp · q` (3 × n).
+    /// The workpiece point is the point of the workpiece body under the TCP at this pose.
     pub tcp: DMatrix<f64>,
+    /// Rotation of the workpiece body, rad: `nest_rotation · q` (3 × n; zero if it is fixed).
+    /// Where the TCP has moved by Δr relative to the workpiece since this pose (a long move),
+    /// the point under it has moved with it, and the deviation there is
+    /// `tcp · q + Δr × (nest_rotation · q)`.
+    pub nest_rotation: DMatrix<f64>,
     /// Axis positions of this assembly, m.
     pub pose_m: Vec<f64>,
     /// Machine source, for messages.
@@ -235,12 +243,18 @@ impl Model {
             let k_ax = d.axial_stiffness_n_per_m(l1);
             let rotor = first_rotor + ai;
             let mut gvec = DVector::zeros(n);
+            // Right-hand thread: turning the nut by θ about e relative to the screw moves it by
+            // θ·h/(2π) along e, so the spring force F on the nut comes with the torque −F·h/(2π)·e,
+            // and its reaction acts on the carrier (screw bearing and motor stator).
+            let h = d.transmission_m_per_rad();
+            let mut twist = SMatrix::<f64, 6, 1>::zeros();
+            twist.fixed_rows_mut::<3>(3).copy_from(&(e * h));
             if let Some((i, t)) = port(a.moving, &d.nut_m) {
-                gvec.rows_mut(i, 6).copy_from(&(t.transpose() * e));
+                gvec.rows_mut(i, 6).copy_from(&(t.transpose() * e - twist));
             }
             if let Some((i, t)) = port_at(a.carrier, &nut) {
                 let mut rows = gvec.rows_mut(i, 6);
-                rows -= t.transpose() * e;
+                rows -= t.transpose() * e - twist;
             }
             gvec[rotor] = -d.transmission_m_per_rad();
             stiffness.ger(k_ax, &gvec, &gvec, 1.0);
@@ -261,7 +275,6 @@ impl Model {
             }
             let mut encoder = DVector::zeros(n);
             encoder[rotor] = sigma * d.transmission_m_per_rad();
-            let h = d.transmission_m_per_rad();
             ports.push(AxisPorts {
                 scale,
                 encoder,
@@ -288,9 +301,18 @@ impl Model {
         if let Some((i, t)) = port(machine.tcp.body, &machine.tcp.point_m) {
             tcp.view_mut((0, i), (3, 6)).copy_from(&t);
         }
-        if let Some((i, t)) = port(machine.workpiece.body, &machine.workpiece.point_m) {
+        // The nest is set up under the tool at this circle centre: the point of the workpiece
+        // body that coincides with the TCP at this pose (CONTRACT: x_ext_mm).
+        let nest = machine.tcp.point_m + shift[machine.tcp.body];
+        if let Some((i, t)) = port_at(machine.workpiece.body, &nest) {
             let mut v = tcp.view_mut((0, i), (3, 6));
             v -= t;
+        }
+        let mut nest_rotation = DMatrix::zeros(3, n);
+        if let Some(i) = body_dof[machine.workpiece.body] {
+            nest_rotation
+                .view_mut((0, i + 3), (3, 3))
+                .fill_with_identity();
         }
         Ok(Model {
             dofs,
@@ -299,6 +321,7 @@ impl Model {
             stiffness,
             axes: ports,
             tcp,
+            nest_rotation,
             pose_m: pose_m.to_vec(),
             machine: machine.source.clone(),
         })
