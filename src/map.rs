@@ -126,19 +126,19 @@ pub fn eij_map(
         if machine.axis(ax).is_none() {
             return Err(MapError::Plane {
                 plane: spec.plane,
-                message: format!("the machine {} has no axis {ax}", machine.name),
+                message: format!("the machine {} has no axis {ax}", machine.name()),
             });
         }
     }
     let mut index = Vec::new();
     for g in grids {
         let i = machine
-            .axes
+            .axes()
             .iter()
             .position(|a| a.axis == g.axis)
             .ok_or_else(|| MapError::Grid {
                 spec: g.axis.to_string(),
-                message: format!("the machine {} has no axis {}", machine.name, g.axis),
+                message: format!("the machine {} has no axis {}", machine.name(), g.axis),
             })?;
         if index.contains(&i) {
             return Err(MapError::Grid {
@@ -146,7 +146,7 @@ pub fn eij_map(
                 message: "axis given twice".into(),
             });
         }
-        let [lo, hi] = machine.axes[i].stroke_m;
+        let [lo, hi] = machine.axes()[i].stroke_m;
         if g.values_m.iter().any(|v| *v < lo || *v > hi) {
             return Err(MapError::Grid {
                 spec: g.axis.to_string(),
@@ -219,7 +219,7 @@ pub fn to_csv(machine: &Machine, spec: &MapSpec, points: &[MapPoint]) -> String 
     out.push('\n');
     for pt in points {
         let mut xyz = [0.0; 3];
-        for (a, v) in machine.axes.iter().zip(&pt.position_m) {
+        for (a, v) in machine.axes().iter().zip(&pt.position_m) {
             xyz[a.axis.index()] = v * 1e3;
         }
         out.push_str(&format!(

@@ -238,15 +238,15 @@ impl Prediction {
         let mut test_pose = Vec::with_capacity(tests.len());
         for (index, t) in tests.iter().enumerate() {
             let pose = t.position_m.as_ref().unwrap_or(&default);
-            if pose.len() != machine.axes.len() {
+            if pose.len() != machine.axes().len() {
                 return Err(PredictError::PositionLength {
                     index,
                     test: t.label(),
                     given: pose.len(),
-                    machine: machine.name.clone(),
-                    axes: machine.axes.len(),
+                    machine: machine.name().to_string(),
+                    axes: machine.axes().len(),
                     names: machine
-                        .axes
+                        .axes()
                         .iter()
                         .map(|a| a.axis.name())
                         .collect::<Vec<_>>()

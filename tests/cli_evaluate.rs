@@ -539,3 +539,32 @@ fn test_entries_state_conditions_that_are_checked() {
     );
     assert_eq!(r.stderr.lines().count(), 2, "{}", r.stderr);
 }
+
+#[test]
+fn evaluate_json_is_read_back_by_the_type_that_writes_it() {
+    // One serde type per file format: every test of a folder's JSON (conditions from its
+    // rtest.toml, ISO 230-4 figures, plane and ellipse routes) parses into `TestJson` and
+    // serialises back to the very same JSON; the numbers are those of the evaluation.
+    let r = run(&["evaluate", "measurements/demo-vmc/pos-b", "--json"]);
+    assert!(r.ok, "{}", r.stderr);
+    let v: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+    let tests = v["tests"].as_array().unwrap();
+    assert_eq!(tests.len(), 18);
+    for t in tests {
+        let typed: eij::rtest::json::TestJson = serde_json::from_value(t.clone()).unwrap();
+        assert_eq!(&serde_json::to_value(&typed).unwrap(), t);
+        assert_eq!(typed.radius_source, "rtest.toml");
+        assert_eq!(
+            typed.position_mm.as_deref(),
+            Some(&[-150.0, 100.0, 0.0][..])
+        );
+        assert_eq!(typed.circle.eij_um_s2_per_m.len(), 6);
+        assert!(typed.circle.iso230_4.is_some() && typed.circle.ellipse_fit.is_some());
+        let e = typed
+            .circle
+            .eij_um_s2_per_m
+            .values()
+            .fold(0.0_f64, |m, v| m.max(v.abs()));
+        assert!(e > 0.5 && e < 5.0, "{}: largest EIJ {e}", typed.circle.file);
+    }
+}

@@ -47,7 +47,7 @@ fn noise_free_factors_are_recovered_from_catalogue_start() {
         .collect();
     let mut truth = machine.clone();
     for (p, v) in params.iter().zip(truth_values) {
-        p.set(&mut truth, v);
+        p.set(&mut truth, v).unwrap();
     }
     let settings = Settings::default();
     let mut tests = conditions(&Plane::ALL, &[3.0, 7.0]);
@@ -78,7 +78,9 @@ fn fixed_bed_machine() -> Machine {
         .to_string()
         + &demo_text()[demo_text().find("# ---------------------------------------------------------------- X").unwrap()..];
     let machine = Machine::from_toml_str(&text, "fixed-bed").unwrap();
-    assert!(machine.bodies.iter().any(|b| b.name == "bed" && b.fixed) && machine.joints.is_empty());
+    assert!(
+        machine.bodies().iter().any(|b| b.name == "bed" && b.fixed) && machine.joints().is_empty()
+    );
     machine
 }
 
@@ -90,8 +92,8 @@ fn a_parameter_without_influence_is_reported_not_identifiable() {
         .map(|n| Parameter::parse(n, &machine).unwrap())
         .collect();
     let mut truth = machine.clone();
-    params[0].set(&mut truth, 0.6);
-    params[1].set(&mut truth, 0.8);
+    params[0].set(&mut truth, 0.6).unwrap();
+    params[1].set(&mut truth, 0.8).unwrap();
     let settings = Settings::default();
     let mut tests = conditions(&[Plane::Xy], &[2.0, 5.0, 8.0]);
     synthetic(&truth, &mut tests, &settings);

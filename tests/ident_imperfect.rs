@@ -30,7 +30,7 @@ fn with_factors(base: &Machine, truth: &[(&str, f64)]) -> (Vec<Parameter>, Machi
         .collect();
     let mut m = base.clone();
     for (p, (_, v)) in params.iter().zip(truth) {
-        p.set(&mut m, *v);
+        p.set(&mut m, *v).unwrap();
     }
     (params, m)
 }

@@ -167,7 +167,7 @@ fn matrices_are_symmetric_and_stiffness_is_positive_semidefinite() {
             eig.min()
         );
         // Exactly one zero-energy motion per drive: slide, everything it carries and rotor.
-        for i in 0..machine.axes.len() {
+        for i in 0..machine.axes().len() {
             let v = m.drive_mode(&machine, i);
             let kv = &m.stiffness * &v;
             assert!(
@@ -329,13 +329,13 @@ fn whole_machine_motion(
 ) -> nalgebra::DVector<f64> {
     let mut v = nalgebra::DVector::zeros(model.n_dof());
     let mut i = 0;
-    for (b, body) in machine.bodies.iter().enumerate() {
+    for (b, body) in machine.bodies().iter().enumerate() {
         if body.fixed {
             continue;
         }
         // The body's COG at this pose: shifted by every axis that carries it.
         let mut c = body.cog_m;
-        for (ai, a) in machine.axes.iter().enumerate() {
+        for (ai, a) in machine.axes().iter().enumerate() {
             if machine.is_carried_by(b, ai) {
                 c += a.direction() * (a.side.sign() * (pose[ai] - a.reference_m));
             }

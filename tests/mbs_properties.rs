@@ -28,7 +28,7 @@ proptest! {
         let eig = k.clone().symmetric_eigen();
         let min = eig.eigenvalues.min();
         prop_assert!(min >= -1e-9 * scale, "eigenvalue {min} of K (max |K| {scale})");
-        for i in 0..machine.axes.len() {
+        for i in 0..machine.axes().len() {
             let v = model.drive_mode(&machine, i);
             let kv = (k * &v).amax();
             prop_assert!(kv <= 1e-9 * scale * v.amax(), "axis {i}: |K v| = {kv}");

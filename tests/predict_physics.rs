@@ -111,14 +111,14 @@ fn on_fast_circles_the_feet_act_only_through_the_machine_inertia() {
 fn quasi_static_eij(machine: &Machine, pose: &[f64]) -> BTreeMap<Eij, f64> {
     let model = Model::assemble(machine, pose).unwrap();
     let n = model.n_dof();
-    let na = machine.axes.len();
+    let na = machine.axes().len();
     // Rigid motion of each axis per metre of axis travel.
     let mut out = BTreeMap::new();
-    for (j, axis) in machine.axes.iter().enumerate() {
+    for (j, axis) in machine.axes().iter().enumerate() {
         let sigma = axis.side.sign();
         let mut r = DVector::zeros(n);
         let mut dof = 0;
-        for (b, body) in machine.bodies.iter().enumerate() {
+        for (b, body) in machine.bodies().iter().enumerate() {
             if body.fixed {
                 continue;
             }
@@ -144,7 +144,7 @@ fn quasi_static_eij(machine: &Machine, pose: &[f64]) -> BTreeMap<Eij, f64> {
         let x = kkt.lu().solve(&rhs).expect("the scales pin every drive");
         let q = x.rows(0, n);
         let dev = &model.tcp * q;
-        for (i, a) in machine.axes.iter().enumerate() {
+        for (i, a) in machine.axes().iter().enumerate() {
             out.insert(Eij::new(a.axis, axis.axis), dev[i] * 1e6);
         }
     }

@@ -29,8 +29,8 @@ pub fn run(args: ExportArgs) -> anyhow::Result<()> {
     let cl = ClosedLoop::new(&machine, &pose)?;
     let m = &cl.model;
     let out = json!({
-        "machine": machine.name,
-        "source": machine.source,
+        "machine": machine.name(),
+        "source": machine.source(),
         "pose_m": pose,
         "units": "SI: m, rad, kg, N, s",
         "dofs": m.dofs,

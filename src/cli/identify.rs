@@ -329,7 +329,7 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
         inputs.push(c.clone());
     }
     let input_refs: Vec<&Path> = inputs.iter().map(|p| p.as_path()).collect();
-    let stem = file_stem(&Machine::from_file(&args.machine)?.name);
+    let stem = file_stem(&Machine::from_file(&args.machine)?.name());
     let default_out = Path::new(DEFAULT_DIR).join(format!("{stem}-identified.toml"));
     let default_report = Path::new(DEFAULT_DIR).join(format!("{stem}-identify-report.json"));
     let out = args.out.clone().unwrap_or(default_out);

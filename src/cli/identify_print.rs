@@ -15,7 +15,7 @@ pub(super) fn print_result(p: &Problem, result: &IdentResult, seconds: f64) {
     };
     println!(
         "{verb} {} from {} tests ({} values), {} iterations, {:.1} s",
-        p.machine().name,
+        p.machine().name(),
         p.tests().len(),
         result.residuals,
         result.iterations,

@@ -27,21 +27,21 @@ impl MachineArgs {
         let pose = match &self.position_mm {
             None => machine.reference_pose(),
             Some(p) => {
-                if p.len() != machine.axes.len() {
+                if p.len() != machine.axes().len() {
                     anyhow::bail!(
                         "--position-mm: {} values given, machine {} has {} axes ({})",
                         p.len(),
                         self.machine.display(),
-                        machine.axes.len(),
+                        machine.axes().len(),
                         machine
-                            .axes
+                            .axes()
                             .iter()
                             .map(|a| a.axis.name())
                             .collect::<Vec<_>>()
                             .join(", ")
                     );
                 }
-                for (a, v) in machine.axes.iter().zip(p) {
+                for (a, v) in machine.axes().iter().zip(p) {
                     let [lo, hi] = a.stroke_m.map(|s| s * 1e3);
                     if !(v.is_finite() && lo <= *v && *v <= hi) {
                         anyhow::bail!(

@@ -71,9 +71,14 @@ pub fn run(args: MapArgs) -> anyhow::Result<()> {
         accel_m_s2: args.accel_m_s2,
     };
     let points = eij_map(&machine, &grids, &spec).map_err(super::advice::map)?;
-    let axes: Vec<_> = machine.axes.iter().map(|a| a.axis).collect();
+    let axes: Vec<_> = machine.axes().iter().map(|a| a.axis).collect();
     let svg = match &args.plot {
-        Some(_) => Some(eij::report::map_svg(&machine.name, &axes, &spec, &points)?),
+        Some(_) => Some(eij::report::map_svg(
+            &machine.name(),
+            &axes,
+            &spec,
+            &points,
+        )?),
         None => None,
     };
     write_output(

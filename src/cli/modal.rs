@@ -22,7 +22,7 @@ pub fn run(args: ModalArgs) -> anyhow::Result<()> {
     let modes = modal::modes(&model)?;
     if args.json {
         let out = json!({
-            "machine": machine.source,
+            "machine": machine.source(),
             "pose_m": pose,
             "frequencies_hz": modes.iter().map(|m| m.frequency_hz).collect::<Vec<_>>(),
             "modes": modes.iter().map(|m| json!({
@@ -36,9 +36,9 @@ pub fn run(args: ModalArgs) -> anyhow::Result<()> {
     }
     println!(
         "Undamped modes of {} at {} (rigid-body modes of the drives at 0 Hz)",
-        machine.name,
+        machine.name(),
         machine
-            .axes
+            .axes()
             .iter()
             .zip(&pose)
             .map(|(a, p)| format!("{}={:.1} mm", a.axis, p * 1e3))

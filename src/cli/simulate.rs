@@ -194,10 +194,10 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
 
 fn run_move(common: &Common, mv: &JerkLimitedMove) -> anyhow::Result<()> {
     let (machine, pose) = common.machine.load()?;
-    let Some(i) = machine.axes.iter().position(|a| a.axis == mv.axis) else {
-        bail!("{}: the machine has no axis {}", machine.source, mv.axis);
+    let Some(i) = machine.axes().iter().position(|a| a.axis == mv.axis) else {
+        bail!("{}: the machine has no axis {}", machine.source(), mv.axis);
     };
-    let [lo, hi] = machine.axes[i].stroke_m;
+    let [lo, hi] = machine.axes()[i].stroke_m;
     let end = pose[i] + mv.distance_m;
     if end < lo || end > hi {
         bail!(
@@ -234,7 +234,7 @@ fn run_setpoint(
         if machine.axis(ax).is_none() {
             bail!(
                 "{}: the machine has no axis {ax}, cannot run a circle in plane {plane}",
-                machine.source
+                machine.source()
             );
         }
     }
@@ -248,7 +248,7 @@ fn conditions(common: &Common, machine: &Machine, pose: &[f64]) -> Conditions {
         source: format!("simulated ({})", common.out.display()),
         machine: Some(format!(
             "{} ({})",
-            machine.name,
+            machine.name(),
             common.machine.machine.display()
         )),
         position_mm: Some(pose.iter().map(|p| p * 1e3).collect()),

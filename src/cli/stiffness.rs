@@ -41,7 +41,7 @@ pub fn run(args: StiffnessArgs) -> anyhow::Result<()> {
 pub fn text(machine: &Machine, table: &StiffnessTable) -> String {
     let mut s = format!(
         "Stiffness of {} (N/µm per element; value = file × factor)\n\n",
-        machine.name
+        machine.name()
     );
     s.push_str(&format!(
         "  {:<4} {:<9} {:<9} {:>5} {:>10} {:>8} {:>10}",

@@ -94,12 +94,12 @@ impl ClosedLoop {
     /// Closes the loops around an assembled model without any check.
     pub fn from_model(machine: &Machine, model: Model) -> ClosedLoop {
         let n = model.n_dof();
-        let na = machine.axes.len();
+        let na = machine.axes().len();
         let lagged: Vec<usize> = (0..na)
-            .filter(|&i| machine.axes[i].control.current_lag_s > 0.0)
+            .filter(|&i| machine.axes()[i].control.current_lag_s > 0.0)
             .collect();
         let filtered: Vec<usize> = (0..na)
-            .filter(|&i| machine.axes[i].control.setpoint_filter_s > 0.0)
+            .filter(|&i| machine.axes()[i].control.setpoint_filter_s > 0.0)
             .collect();
         let nx = 2 * n + na + lagged.len() + filtered.len();
         let nu = INPUTS_PER_AXIS * na;
@@ -124,7 +124,7 @@ impl ClosedLoop {
                     cau[(i, ua)] = 1.0;
                 }
                 Some(k) => {
-                    let tf = machine.axes[i].control.setpoint_filter_s;
+                    let tf = machine.axes()[i].control.setpoint_filter_s;
                     cpx[(i, i_f + k)] = 1.0;
                     cvx[(i, i_f + k)] = -1.0 / tf;
                     cvu[(i, up)] = 1.0 / tf;
@@ -144,7 +144,7 @@ impl ClosedLoop {
         // Following error x_cmd − x_fb.
         let mut fx = cpx.clone();
         let fu = cpu.clone();
-        for (i, a) in machine.axes.iter().enumerate() {
+        for (i, a) in machine.axes().iter().enumerate() {
             let p = &model.axes[i];
             let c = &a.control;
             let fb = match c.feedback {
@@ -207,7 +207,7 @@ impl ClosedLoop {
         a_mat.view_mut((iz, 0), (na, nx)).copy_from(&ex);
         b_mat.view_mut((iz, 0), (na, nu)).copy_from(&eu);
         for (k, &i) in lagged.iter().enumerate() {
-            let tc = machine.axes[i].control.current_lag_s;
+            let tc = machine.axes()[i].control.current_lag_s;
             let row = gx.row(i) / tc;
             a_mat.row_mut(it + k).copy_from(&row);
             a_mat[(it + k, it + k)] -= 1.0 / tc;
@@ -224,7 +224,7 @@ impl ClosedLoop {
         let mut c_mat = DMatrix::zeros(ny, nx);
         let mut d_mat = DMatrix::zeros(ny, nu);
         let mut outputs = Vec::with_capacity(ny);
-        for (i, a) in machine.axes.iter().enumerate() {
+        for (i, a) in machine.axes().iter().enumerate() {
             c_mat
                 .view_mut((i, iq), (1, n))
                 .copy_from(&model.axes[i].scale.transpose());
@@ -237,7 +237,7 @@ impl ClosedLoop {
             outputs.push(format!("{ax}_tcp_m"));
         }
         let base = na + 3;
-        for (i, a) in machine.axes.iter().enumerate() {
+        for (i, a) in machine.axes().iter().enumerate() {
             let s = model.axes[i].scale.transpose();
             c_mat.row_mut(base + 3 * i).copy_from(&(&s * &accx));
             d_mat.row_mut(base + 3 * i).copy_from(&(&s * &accu));
@@ -255,17 +255,17 @@ impl ClosedLoop {
         states.extend(model.dofs.iter().map(|d| format!("v:{d}")));
         states.extend(
             machine
-                .axes
+                .axes()
                 .iter()
                 .map(|a| format!("{}.pi_integral", a.axis)),
         );
         states.extend(
             lagged
                 .iter()
-                .map(|&i| format!("{}.torque", machine.axes[i].axis)),
+                .map(|&i| format!("{}.torque", machine.axes()[i].axis)),
         );
         let mut inputs = Vec::with_capacity(nu);
-        for a in &machine.axes {
+        for a in machine.axes() {
             inputs.push(format!("{}_pos_set_m", a.axis));
             inputs.push(format!("{}_vel_set_m_s", a.axis));
             inputs.push(format!("{}_acc_set_m_s2", a.axis));
@@ -278,7 +278,7 @@ impl ClosedLoop {
             states,
             inputs,
             outputs,
-            axes: machine.axes.iter().map(|a| a.axis).collect(),
+            axes: machine.axes().iter().map(|a| a.axis).collect(),
             model,
         }
     }
@@ -310,14 +310,14 @@ impl ClosedLoop {
         let unstable = |re: f64, im: f64| re > 1e-9 * (re * re + im * im).sqrt();
         // Eigenvalues alone decide; eigenvectors are computed only to name the axis.
         let values = self.eigenvalues().ok_or_else(|| ControlError::Eigen {
-            machine: machine.source.clone(),
+            machine: machine.source().to_string(),
         })?;
         if !values.iter().any(|l| unstable(l.re, l.im)) {
             return Ok(());
         }
         let a = faer::Mat::<f64>::from_fn(n, n, |i, j| self.a[(i, j)]);
         let eig = a.eigen().map_err(|_| ControlError::Eigen {
-            machine: machine.source.clone(),
+            machine: machine.source().to_string(),
         })?;
         let s = eig.S();
         let u = eig.U();
@@ -342,7 +342,7 @@ impl ClosedLoop {
             .map_or(self.axes[0], |(i, _)| self.axes[i]);
         let (re, im) = (s[k].re, s[k].im.abs());
         Err(ControlError::Unstable {
-            machine: machine.source.clone(),
+            machine: machine.source().to_string(),
             axis,
             re,
             im,

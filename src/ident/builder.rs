@@ -17,13 +17,14 @@ use std::path::PathBuf;
 /// ```
 /// use eij::ident::{Identification, TestCase};
 /// use eij::predict::{simulated_eij, CircleTest, SimSettings};
+/// use eij::machine::Reduction;
 /// use eij::{Direction, Machine, Plane};
 ///
 /// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/machines/demo-vmc.toml");
 /// let machine = Machine::from_file(std::path::Path::new(path))?;
 /// // "Measured" EIJ: the model with a Z guideway at 60 % of its catalogue stiffness.
 /// let mut truth = machine.clone();
-/// truth.axes[2].guideway.reduction_normal = 0.6;
+/// truth.set_reduction(2, Reduction::GuidewayNormal, 0.6)?;
 /// let circles = vec![
 ///     CircleTest::new(Plane::Zx, Direction::Ccw, 2.0, 4.0),
 ///     CircleTest::new(Plane::Yz, Direction::Cw, 2.0, 6.0),

@@ -20,6 +20,7 @@ use super::problem::Problem;
 use super::statics::{Row, Statics};
 use super::{IdentError, SolverKind};
 use crate::axes::{Direction, Eij, Plane};
+use crate::machine::Machine;
 use crate::predict::{CircleTest, Prediction};
 use nalgebra::{DMatrix, DVector};
 
@@ -113,7 +114,7 @@ fn grid(problem: &Problem) -> Vec<CircleTest> {
         vec![hi]
     };
     let mut poses: Vec<Vec<f64>> = vec![Vec::new()];
-    for a in &machine.axes {
+    for a in machine.axes() {
         let [s0, s1] = a.stroke_m;
         poses = poses
             .into_iter()
@@ -177,7 +178,10 @@ pub fn rank(
         t[i] += h[i];
         thetas.push(t);
     }
-    let machines: Vec<_> = thetas.iter().map(|t| problem.machine_at(t)).collect();
+    let machines: Vec<Machine> = thetas
+        .iter()
+        .map(|t| problem.machine_at(t))
+        .collect::<Result<_, _>>()?;
     let sims = Prediction::new(problem.machine(), candidates.clone(), sim)
         .and_then(|p| p.simulate_with(&machines, SolverKind::Harmonic));
     let sims = match sims {

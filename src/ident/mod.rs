@@ -574,6 +574,6 @@ pub fn identify(
         warnings,
         notes,
         refusal,
-        machine: problem.machine_at(&theta),
+        machine: problem.machine_at(&theta)?,
     })
 }

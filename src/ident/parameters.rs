@@ -3,7 +3,7 @@
 
 use super::IdentError;
 use crate::axes::Axis;
-use crate::machine::Machine;
+use crate::machine::{Machine, MachineError, Reduction};
 
 /// What a parameter scales.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -41,10 +41,10 @@ impl Parameter {
             .ok_or_else(|| bad("expected <axis>.<kind>, e.g. z.guideway_normal".into()))?;
         let axis: Axis = axis.parse().map_err(bad)?;
         let axis_index = machine
-            .axes
+            .axes()
             .iter()
             .position(|a| a.axis == axis)
-            .ok_or_else(|| bad(format!("the machine {} has no axis {axis}", machine.name)))?;
+            .ok_or_else(|| bad(format!("the machine {} has no axis {axis}", machine.name())))?;
         let kind = match kind {
             "guideway" => ParameterKind::Guideway,
             "guideway_normal" => ParameterKind::GuidewayNormal,
@@ -56,7 +56,7 @@ impl Parameter {
                 )))
             }
         };
-        let g = &machine.axes[axis_index].guideway;
+        let g = &machine.axes()[axis_index].guideway;
         if kind == ParameterKind::Guideway && g.reduction_normal != g.reduction_lateral {
             return Err(bad(format!(
                 "the machine's normal ({}) and lateral ({}) factors differ: identify {axis}.guideway_normal and {axis}.guideway_lateral instead",
@@ -73,7 +73,7 @@ impl Parameter {
     /// The default set: normal and lateral guideway factors of every axis.
     pub fn default_set(machine: &Machine) -> Vec<Parameter> {
         let mut v = Vec::new();
-        for (i, a) in machine.axes.iter().enumerate() {
+        for (i, a) in machine.axes().iter().enumerate() {
             for (suffix, kind) in [
                 ("guideway_normal", ParameterKind::GuidewayNormal),
                 ("guideway_lateral", ParameterKind::GuidewayLateral),
@@ -90,25 +90,29 @@ impl Parameter {
 
     /// The factor's value in `machine`.
     pub fn get(&self, machine: &Machine) -> f64 {
-        let a = &machine.axes[self.axis_index];
-        match self.kind {
-            ParameterKind::Guideway | ParameterKind::GuidewayNormal => a.guideway.reduction_normal,
-            ParameterKind::GuidewayLateral => a.guideway.reduction_lateral,
-            ParameterKind::Screw => a.drive.reduction,
-        }
+        let which = match self.kind {
+            ParameterKind::Guideway | ParameterKind::GuidewayNormal => Reduction::GuidewayNormal,
+            ParameterKind::GuidewayLateral => Reduction::GuidewayLateral,
+            ParameterKind::Screw => Reduction::Screw,
+        };
+        machine.reduction(self.axis_index, which)
     }
 
-    /// Sets the factor in `machine`.
-    pub fn set(&self, machine: &mut Machine, value: f64) {
-        let a = &mut machine.axes[self.axis_index];
+    /// Sets the factor in `machine` (finite and > 0).
+    pub fn set(&self, machine: &mut Machine, value: f64) -> Result<(), MachineError> {
+        let i = self.axis_index;
         match self.kind {
             ParameterKind::Guideway => {
-                a.guideway.reduction_normal = value;
-                a.guideway.reduction_lateral = value;
+                machine.set_reduction(i, Reduction::GuidewayNormal, value)?;
+                machine.set_reduction(i, Reduction::GuidewayLateral, value)
             }
-            ParameterKind::GuidewayNormal => a.guideway.reduction_normal = value,
-            ParameterKind::GuidewayLateral => a.guideway.reduction_lateral = value,
-            ParameterKind::Screw => a.drive.reduction = value,
+            ParameterKind::GuidewayNormal => {
+                machine.set_reduction(i, Reduction::GuidewayNormal, value)
+            }
+            ParameterKind::GuidewayLateral => {
+                machine.set_reduction(i, Reduction::GuidewayLateral, value)
+            }
+            ParameterKind::Screw => machine.set_reduction(i, Reduction::Screw, value),
         }
     }
 }

@@ -93,7 +93,8 @@ impl Problem {
                         input: t.source.clone(),
                         message: format!(
                             "plane {} needs axis {ax}, which the model {} does not have",
-                            t.circle.plane, machine.name
+                            t.circle.plane,
+                            machine.name()
                         ),
                     });
                 }
@@ -265,13 +266,13 @@ impl Problem {
         )
     }
 
-    /// The machine with factors p = 1/θ.
-    pub fn machine_at(&self, theta: &DVector<f64>) -> Machine {
+    /// The machine with factors p = 1/θ (an error for a factor that is not finite and > 0).
+    pub fn machine_at(&self, theta: &DVector<f64>) -> Result<Machine, IdentError> {
         let mut m = self.machine.clone();
         for (p, t) in self.params.iter().zip(theta.iter()) {
-            p.set(&mut m, to_factor(*t));
+            p.set(&mut m, to_factor(*t))?;
         }
-        m
+        Ok(m)
     }
 
     /// `name=value, …` of the factors at θ (for messages).
@@ -313,7 +314,10 @@ impl Problem {
     ) -> Result<Vec<Vec<EijMap>>, IdentError> {
         self.evaluations
             .fetch_add(thetas.len() as u64, Ordering::Relaxed);
-        let machines: Vec<Machine> = thetas.iter().map(|t| self.machine_at(t)).collect();
+        let machines: Vec<Machine> = thetas
+            .iter()
+            .map(|t| self.machine_at(t))
+            .collect::<Result<_, _>>()?;
         self.prediction
             .simulate_with(&machines, solver)
             .map_err(|e| match e {

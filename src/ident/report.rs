@@ -504,7 +504,7 @@ pub fn machine_toml(
             .collect(),
         tests: problem.tests().len(),
     });
-    raw.name = format!("{}-identified", problem.machine().name);
+    raw.name = format!("{}-identified", problem.machine().name());
     let body = toml::to_string_pretty(&raw)?;
     let mut header = format!(
         "# Identified by eij {} on {} from {} and {} measured input(s).\n",

@@ -28,7 +28,7 @@ pub fn table_with_std_err<'a>(
     let mut table = StiffnessTable::of(machine);
     table.identified = true;
     for (p, std_err) in fitted {
-        let axis = machine.axes[p.axis_index].axis;
+        let axis = machine.axes()[p.axis_index].axis;
         for &kind in p.kind.factors() {
             table.set_factor_std_err(axis, kind, &p.name, std_err);
         }
@@ -64,7 +64,7 @@ pub fn machine_table(machine: &Machine) -> (StiffnessTable, Vec<String>) {
             Err(e) => {
                 warnings.push(format!(
                     "{}: provenance: {e}; its standard error is left out",
-                    machine.source
+                    machine.source()
                 ));
                 continue;
             }
@@ -73,7 +73,7 @@ pub fn machine_table(machine: &Machine) -> (StiffnessTable, Vec<String>) {
         if recorded.identified != now {
             warnings.push(format!(
                 "{}: {name} = {now} differs from the identified {} recorded in [provenance]: its standard error is left out",
-                machine.source, recorded.identified
+                machine.source(), recorded.identified
             ));
             continue;
         }

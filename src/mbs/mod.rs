@@ -144,18 +144,18 @@ fn add_point_element(target: &mut DMatrix<f64>, a: &Port, b: &Port, k: &Matrix3<
 impl Model {
     /// Assembles M, D, K at axis position `pose_m` (m, machine axis order).
     pub fn assemble(machine: &Machine, pose_m: &[f64]) -> Result<Model, MbsError> {
-        if pose_m.len() != machine.axes.len() {
+        if pose_m.len() != machine.axes().len() {
             return Err(MbsError::PoseLength {
-                machine: machine.source.clone(),
+                machine: machine.source().to_string(),
                 got: pose_m.len(),
-                expected: machine.axes.len(),
+                expected: machine.axes().len(),
             });
         }
-        for (a, &s) in machine.axes.iter().zip(pose_m) {
+        for (a, &s) in machine.axes().iter().zip(pose_m) {
             let [lo, hi] = a.stroke_m;
             if !(s.is_finite() && lo <= s && s <= hi) {
                 return Err(MbsError::OutOfStroke {
-                    machine: machine.source.clone(),
+                    machine: machine.source().to_string(),
                     axis: a.axis.to_string(),
                     position_m: s,
                     min_m: lo,
@@ -163,12 +163,12 @@ impl Model {
                 });
             }
         }
-        let nb = machine.bodies.len();
+        let nb = machine.bodies().len();
         // Shift of every body at this pose.
         let shift: Vec<Vector3<f64>> = (0..nb)
             .map(|b| {
                 machine
-                    .axes
+                    .axes()
                     .iter()
                     .enumerate()
                     .filter(|(ai, _)| machine.is_carried_by(b, *ai))
@@ -178,7 +178,7 @@ impl Model {
             .collect();
         let mut body_dof = vec![None; nb];
         let mut dofs = Vec::new();
-        for (b, body) in machine.bodies.iter().enumerate() {
+        for (b, body) in machine.bodies().iter().enumerate() {
             if !body.fixed {
                 body_dof[b] = Some(dofs.len());
                 for d in ["x", "y", "z", "a", "b", "c"] {
@@ -187,12 +187,12 @@ impl Model {
             }
         }
         let first_rotor = dofs.len();
-        for a in &machine.axes {
+        for a in machine.axes() {
             dofs.push(format!("{}.motor", a.axis));
         }
         let n = dofs.len();
         let cog: Vec<Vector3<f64>> = (0..nb)
-            .map(|b| machine.bodies[b].cog_m + shift[b])
+            .map(|b| machine.bodies()[b].cog_m + shift[b])
             .collect();
         // A point of body b given at the reference position, at this pose.
         let port = |b: usize, p_ref: &Vector3<f64>| -> Port {
@@ -204,7 +204,7 @@ impl Model {
         };
 
         let mut mass = DMatrix::zeros(n, n);
-        for (b, body) in machine.bodies.iter().enumerate() {
+        for (b, body) in machine.bodies().iter().enumerate() {
             if let Some(i) = body_dof[b] {
                 for d in 0..3 {
                     mass[(i + d, i + d)] = body.mass_kg;
@@ -215,9 +215,9 @@ impl Model {
         }
         let mut stiffness = DMatrix::zeros(n, n);
         let mut damping = DMatrix::zeros(n, n);
-        let mut ports = Vec::with_capacity(machine.axes.len());
+        let mut ports = Vec::with_capacity(machine.axes().len());
 
-        for (ai, a) in machine.axes.iter().enumerate() {
+        for (ai, a) in machine.axes().iter().enumerate() {
             let e = a.direction();
             let g = &a.guideway;
             let kn = g.normal_n_per_m * g.reduction_normal;
@@ -284,7 +284,7 @@ impl Model {
             });
         }
 
-        for j in &machine.joints {
+        for j in machine.joints() {
             let p = j.point_m + shift[j.body];
             let k = Matrix3::from_diagonal(&j.stiffness_n_per_m);
             let c = Matrix3::from_diagonal(&j.damping_n_s_per_m);
@@ -293,23 +293,23 @@ impl Model {
             add_point_element(&mut stiffness, &pa, &pb, &k);
             add_point_element(&mut damping, &pa, &pb, &c);
         }
-        if machine.rayleigh_beta_s > 0.0 {
-            damping += &stiffness * machine.rayleigh_beta_s;
+        if machine.rayleigh_beta_s() > 0.0 {
+            damping += &stiffness * machine.rayleigh_beta_s();
         }
 
         let mut tcp = DMatrix::zeros(3, n);
-        if let Some((i, t)) = port(machine.tcp.body, &machine.tcp.point_m) {
+        if let Some((i, t)) = port(machine.tcp().body, &machine.tcp().point_m) {
             tcp.view_mut((0, i), (3, 6)).copy_from(&t);
         }
         // The nest is set up under the tool at this circle centre: the point of the workpiece
         // body that coincides with the TCP at this pose (CONTRACT: x_ext_mm).
-        let nest = machine.tcp.point_m + shift[machine.tcp.body];
-        if let Some((i, t)) = port_at(machine.workpiece.body, &nest) {
+        let nest = machine.tcp().point_m + shift[machine.tcp().body];
+        if let Some((i, t)) = port_at(machine.workpiece().body, &nest) {
             let mut v = tcp.view_mut((0, i), (3, 6));
             v -= t;
         }
         let mut nest_rotation = DMatrix::zeros(3, n);
-        if let Some(i) = body_dof[machine.workpiece.body] {
+        if let Some(i) = body_dof[machine.workpiece().body] {
             nest_rotation
                 .view_mut((0, i + 3), (3, 3))
                 .fill_with_identity();
@@ -323,7 +323,7 @@ impl Model {
             tcp,
             nest_rotation,
             pose_m: pose_m.to_vec(),
-            machine: machine.source.clone(),
+            machine: machine.source().to_string(),
         })
     }
 
@@ -336,10 +336,10 @@ impl Model {
     /// axis in the physical sense σ·e and the rotor turns with it; K·v = 0 for a supported
     /// structure.
     pub fn drive_mode(&self, machine: &Machine, i: usize) -> DVector<f64> {
-        let a = &machine.axes[i];
+        let a = &machine.axes()[i];
         let mut v = DVector::zeros(self.n_dof());
         let mut dof = 0;
-        for (b, body) in machine.bodies.iter().enumerate() {
+        for (b, body) in machine.bodies().iter().enumerate() {
             if body.fixed {
                 continue;
             }
@@ -350,7 +350,7 @@ impl Model {
             }
             dof += 6;
         }
-        v[self.axes[i].rotor_dof] = 1.0 / machine.axes[i].drive.transmission_m_per_rad();
+        v[self.axes[i].rotor_dof] = 1.0 / machine.axes()[i].drive.transmission_m_per_rad();
         v
     }
 }

@@ -107,7 +107,7 @@ pub fn check_support(model: &Model, machine: &Machine) -> Result<(), MbsError> {
     let rigid: Vec<usize> = (0..values.len())
         .filter(|&i| values[i] <= RIGID_RELATIVE * max)
         .collect();
-    let expected = machine.axes.len();
+    let expected = machine.axes().len();
     if rigid.len() <= expected {
         return Ok(());
     }

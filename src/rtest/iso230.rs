@@ -11,7 +11,7 @@
 use super::normalise::circle_centre;
 
 /// The ISO 230-4 figures of one path.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PathFigures {
     /// Circular deviation G: the radial range (largest minus smallest radius) about the
     /// least-squares centre, µm.
@@ -28,7 +28,7 @@ pub struct PathFigures {
 }
 
 /// The figures of both paths of a test.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CircleFigures {
     /// The nominal (set) radius the radial deviations refer to, mm.
     pub nominal_radius_mm: f64,

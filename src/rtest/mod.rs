@@ -31,7 +31,7 @@
 
 use std::collections::BTreeMap;
 
-use serde_json::{json, Map, Value};
+use serde_json::{json, Value};
 
 use crate::axes::{Axis, Direction, Eij, Plane};
 
@@ -43,6 +43,7 @@ pub mod error;
 pub mod fit;
 pub mod inputs;
 pub mod iso230;
+pub mod json;
 pub mod layout;
 pub mod lstsq;
 pub mod normalise;
@@ -239,68 +240,6 @@ impl CircleResult {
     /// plus `measured_radius_mm`, `offsets_um`, `revolutions`, `samples_used`, `plane_fit`,
     /// `ellipse_fit` (null when it failed) and `warnings`.
     pub fn to_json(&self) -> Value {
-        let mut m = Map::new();
-        m.insert("file".into(), json!(self.source));
-        m.insert("plane".into(), json!(self.plane.name()));
-        m.insert("direction".into(), json!(self.direction.name()));
-        m.insert("radius_mm".into(), json!(self.radius_mm));
-        m.insert("accel_m_s2".into(), json!(self.accel_m_s2));
-        m.insert("freq_hz".into(), json!(self.freq_hz));
-        m.insert("eij_um_s2_per_m".into(), eij_json(&self.eij));
-        m.insert("std_err_um_s2_per_m".into(), eij_json(&self.std_err));
-        m.insert("rms_residual_um".into(), json!(self.rms_residual_um));
-        m.insert("measured_radius_mm".into(), json!(self.measured_radius_mm));
-        let offsets: Map<String, Value> = self
-            .offsets_um
-            .iter()
-            .map(|(k, v)| (k.name().to_string(), json!(v)))
-            .collect();
-        m.insert("offsets_um".into(), Value::Object(offsets));
-        m.insert("revolutions".into(), json!(self.revolutions));
-        m.insert("samples_used".into(), json!(self.samples_used));
-        m.insert(
-            "plane_fit".into(),
-            json!({
-                "eij_um_s2_per_m": eij_json(&self.plane_fit.eij),
-                "std_err_um_s2_per_m": eij_json(&self.plane_fit.std_err),
-            }),
-        );
-        let ellipse = self.ellipse_fit.as_ref().map_or(Value::Null, |e| {
-            json!({
-                "eij_um_s2_per_m": eij_json(&e.eij),
-                "half_width_int_mm": e.half_width_int_mm,
-                "half_width_ext_mm": e.half_width_ext_mm,
-                "predicted_from_joint_um_s2_per_m": eij_json(&e.predicted_from_joint),
-            })
-        });
-        m.insert("ellipse_fit".into(), ellipse);
-        if let Some(iso) = &self.iso230 {
-            m.insert(
-                "circular_deviation_um".into(),
-                json!({
-                    "internal": iso.internal.circular_deviation_um,
-                    "external": iso.external.circular_deviation_um,
-                }),
-            );
-            let path = |p: &iso230::PathFigures| {
-                json!({
-                    "circular_deviation_um": p.circular_deviation_um,
-                    "radial_deviation_max_um": p.radial_deviation_max_um,
-                    "radial_deviation_min_um": p.radial_deviation_min_um,
-                    "mean_radius_deviation_um": p.mean_radius_deviation_um,
-                    "centre_mm": p.centre_mm,
-                })
-            };
-            m.insert(
-                "iso230_4".into(),
-                json!({
-                    "nominal_radius_mm": iso.nominal_radius_mm,
-                    "internal": path(&iso.internal),
-                    "external": path(&iso.external),
-                }),
-            );
-        }
-        m.insert("warnings".into(), json!(self.warnings));
-        Value::Object(m)
+        serde_json::to_value(json::CircleJson::from(self)).unwrap_or(Value::Null)
     }
 }

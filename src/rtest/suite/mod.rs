@@ -11,6 +11,7 @@ use super::inputs::TestInput;
 use super::normalise::Normalised;
 use super::{evaluate, iso230, CircleResult, CircleSeries, EvalOptions};
 use crate::axes::{Direction, Eij, Plane};
+use crate::rtest::json::{CircleJson, TestJson, TimeOffsetJson};
 
 mod clocks;
 use clocks::{align_clock, lag_of_clock};
@@ -345,30 +346,26 @@ impl EvaluatedTest {
     /// `time_offset_ms` with `time_offset` (`std_err_ms`, `source`, `clock`, `alignment_ms`),
     /// `position_mm` and `note`.
     pub fn to_json(&self) -> serde_json::Value {
-        let mut v = self.result.to_json();
-        if let serde_json::Value::Object(m) = &mut v {
-            m.insert("file".into(), self.input.name().into());
-            m.insert("radius_source".into(), self.radius_source.name().into());
-            if let Some(o) = &self.time_offset {
-                m.insert("time_offset_ms".into(), o.offset_ms.into());
-                m.insert(
-                    "time_offset".into(),
-                    serde_json::json!({
-                        "std_err_ms": o.std_err_ms,
-                        "source": o.source.name(),
-                        "clock": o.clock,
-                        "alignment_ms": o.alignment_ms,
-                    }),
-                );
-            }
-            if let Some(p) = &self.input.position_mm {
-                m.insert("position_mm".into(), serde_json::json!(p));
-            }
-            if let Some(n) = &self.input.note {
-                m.insert("note".into(), n.clone().into());
-            }
+        serde_json::to_value(self.to_typed()).unwrap_or(serde_json::Value::Null)
+    }
+
+    /// The same as the typed [`TestJson`].
+    pub fn to_typed(&self) -> TestJson {
+        let mut circle = CircleJson::from(&self.result);
+        circle.file = self.input.name().to_string();
+        TestJson {
+            circle,
+            radius_source: self.radius_source.name().to_string(),
+            time_offset_ms: self.time_offset.as_ref().map(|o| o.offset_ms),
+            time_offset: self.time_offset.as_ref().map(|o| TimeOffsetJson {
+                std_err_ms: o.std_err_ms,
+                source: o.source.name().to_string(),
+                clock: o.clock.clone(),
+                alignment_ms: o.alignment_ms,
+            }),
+            position_mm: self.input.position_mm.clone(),
+            note: self.input.note.clone(),
         }
-        v
     }
 }
 
