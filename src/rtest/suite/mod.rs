@@ -265,7 +265,7 @@ fn condition_warnings(input: &TestInput, r: &CircleResult, source: RadiusSource)
     if source == RadiusSource::Fallback {
         w.push(format!(
             "no set radius in the test's conditions (rtest.toml radius_mm or [[test]]): the \
-             caller's radius {:.4} mm (identify: config radius_mm, default 2 mm) is taken as the \
+             caller's radius {:.4} mm (identify: --radius-mm or config radius_mm, default 2 mm) is taken as the \
              set radius; the data's mean internal radius is {:.4} mm",
             r.radius_mm, r.measured_radius_mm
         ));
