@@ -68,14 +68,20 @@ impl NotIdentifiable {
                 )
             })
             .collect();
+        let partner_names: Vec<&str> = self
+            .tied_to
+            .iter()
+            .map(|(k, _)| names[*k].as_str())
+            .collect();
         format!(
-            "{name} is not identifiable: the tests cannot separate it from {} — changing them together along the null direction changes no measured EIJ{}; kept at {kept_at}",
+            "{name} is not identifiable: the tests cannot separate it from {} — changing them together along the null direction changes no measured EIJ{}; kept at {kept_at}, so the values identified for {} hold only for {name} = {kept_at} (their standard errors do not include that assumption)",
             partners.join(", "),
             if self.rel_std_err.is_finite() {
                 format!(" (predicted standard error {:.0} % of its value)", 100.0 * self.rel_std_err)
             } else {
                 String::new()
-            }
+            },
+            partner_names.join(", ")
         )
     }
 }
