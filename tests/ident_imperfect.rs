@@ -276,7 +276,11 @@ fn one_plane_names_the_factors_it_cannot_determine_and_ranks_tests_that_would() 
     }
     assert!(result.warnings.iter().all(|w| !w.contains("bound")));
     // The partners' values are conditional on the held one, and the warning says so.
-    for w in result.warnings.iter().filter(|w| w.contains("cannot separate it from")) {
+    for w in result
+        .warnings
+        .iter()
+        .filter(|w| w.contains("cannot separate it from"))
+    {
         assert!(w.contains("hold only for"), "{w}");
     }
     let design = result.design.as_ref().unwrap();
