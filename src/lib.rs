@@ -59,6 +59,7 @@
 //! `cargo build --lib --no-default-features` builds the bare library.
 
 pub mod axes;
+pub mod compensation;
 pub mod control;
 pub mod ident;
 pub mod io;

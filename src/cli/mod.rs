@@ -3,7 +3,9 @@
 use clap::{Parser, Subcommand};
 
 mod advice;
+mod compensation;
 pub mod evaluate;
+mod evaluate_move;
 mod export;
 mod identify;
 mod identify_print;
@@ -26,6 +28,9 @@ pub struct Cli {
 enum Command {
     /// Evaluate R-Test circle-test series into EIJ with standard errors.
     Evaluate(evaluate::EvaluateArgs),
+    /// EIJ of the moved axis from a positioning move (external − internal against the set
+    /// acceleration).
+    EvaluateMove(evaluate_move::EvaluateMoveArgs),
     /// Simulate a circle test or a positioning move on a machine model.
     Simulate(simulate::SimulateArgs),
     /// Undamped modes of a machine model.
@@ -40,6 +45,8 @@ enum Command {
     Map(map::MapArgs),
     /// The stiffness set of a machine file as a table (catalogue × factor, N/µm).
     Stiffness(stiffness::StiffnessArgs),
+    /// Cross-talk compensation coefficients k_IJ(s_K) = offset + slope·s_K from a model.
+    Compensation(compensation::CompensationArgs),
     /// Write an offline HTML report with SVG figures (circle tests, moves, identification).
     Report(report::ReportArgs),
 }
@@ -49,6 +56,7 @@ impl Cli {
     pub fn run(self) -> anyhow::Result<()> {
         match self.command {
             Command::Evaluate(args) => evaluate::run(args),
+            Command::EvaluateMove(args) => evaluate_move::run(args),
             Command::Simulate(args) => simulate::run(args),
             Command::Modal(args) => modal::run(args),
             Command::Export(args) => export::run(args),
@@ -57,6 +65,7 @@ impl Cli {
             Command::Map(args) => map::run(args),
             Command::Report(args) => report::run(args),
             Command::Stiffness(args) => stiffness::run(args),
+            Command::Compensation(args) => compensation::run(args),
         }
     }
 }

@@ -3,6 +3,7 @@
 use super::machine_args::{write_output, MachineArgs};
 use anyhow::bail;
 use eij::axes::{Axis, Direction, Plane};
+use eij::compensation::{Compensated, CompensationTable};
 use eij::control::ClosedLoop;
 use eij::machine::Machine;
 use eij::report::{move_svg, CircleView, Conditions, MoveData};
@@ -54,6 +55,55 @@ struct Common {
     /// series, or the move plot (position, acceleration, cross-talk over time).
     #[arg(long, value_name = "FILE.svg")]
     plot: Option<PathBuf>,
+    /// Apply a compensation table (`eij compensation`) as feed-forward on the set points:
+    /// `<axis>_set_mm` stays the nominal path, `<axis>_comp_mm` holds the correction.
+    #[arg(long, value_name = "TABLE.csv")]
+    compensation: Option<PathBuf>,
+}
+
+impl Common {
+    /// Every file the run reads.
+    fn inputs(&self) -> Vec<&std::path::Path> {
+        let mut v = vec![self.machine.machine.as_path()];
+        v.extend(self.compensation.as_deref());
+        v
+    }
+
+    /// The compensation table, if one is given.
+    fn table(&self, machine: &Machine) -> anyhow::Result<Option<CompensationTable>> {
+        Ok(match &self.compensation {
+            Some(p) => Some(CompensationTable::read(p, machine)?),
+            None => None,
+        })
+    }
+}
+
+/// The set point with the compensation applied (if any), and the correction per output sample.
+fn compensate<'a>(
+    sp: &'a dyn SetPoint,
+    table: Option<&'a CompensationTable>,
+    pose: &[f64],
+    machine: &Machine,
+) -> Option<Compensated<'a>> {
+    let table = table?;
+    let mut origin_mm = [0.0; 3];
+    for (a, p) in machine.axes().iter().zip(pose) {
+        origin_mm[a.axis.index()] = p * 1e3;
+    }
+    Some(Compensated {
+        nominal: sp,
+        table,
+        origin_mm,
+    })
+}
+
+/// The correction at every sample of `run`, laid out like its inputs.
+fn corrections(comp: &Compensated, cl: &ClosedLoop, run: &eij::sim::Run) -> Vec<f64> {
+    let mut out = vec![0.0; run.inputs.len()];
+    for (k, t) in run.t_s.iter().enumerate() {
+        comp.correction(*t, &cl.axes, &mut out[k * run.nu..(k + 1) * run.nu]);
+    }
+    out
 }
 
 /// What `--plot` draws.
@@ -139,7 +189,7 @@ fn check_samples(common: &Common, sp: &dyn SetPoint, freq_hz: Option<f64>) -> an
     }
     let mut outputs = vec![common.out.as_path()];
     outputs.extend(common.plot.as_deref());
-    eij::io::check_outputs(&outputs, &[&common.machine.machine])?;
+    eij::io::check_outputs(&outputs, &common.inputs())?;
     Ok(())
 }
 
@@ -210,16 +260,18 @@ fn run_move(common: &Common, mv: &JerkLimitedMove) -> anyhow::Result<()> {
     }
     // Re-assembled every 10 mm of travel (eij::sim::move_segments).
     let rate = positive("rate-hz", common.rate_hz)?;
+    let table = common.table(&machine)?;
     let segments = eij::sim::move_segments(&machine, &pose, i, mv, rate)?;
     let cond = conditions(common, &machine, &pose);
-    let run = eij::sim::simulate_segments(&segments, mv)?;
-    write_output_files(
-        common,
-        &segments[0].closed_loop,
-        run,
-        PlotKind::Move(mv.axis),
-        cond,
-    )
+    let comp = compensate(mv, table.as_ref(), &pose, &machine);
+    let sp: &dyn SetPoint = match &comp {
+        Some(c) => c,
+        None => mv,
+    };
+    let run = eij::sim::simulate_segments(&segments, sp)?;
+    let cl = &segments[0].closed_loop;
+    let correction = comp.as_ref().map(|c| corrections(c, cl, &run));
+    write_output_files(common, cl, run, PlotKind::Move(mv.axis), cond, correction)
 }
 
 fn run_setpoint(
@@ -240,7 +292,22 @@ fn run_setpoint(
     }
     let cl = ClosedLoop::new(&machine, &pose)?;
     let cond = conditions(common, &machine, &pose);
-    write_run(common, &cl, sp, PlotKind::Circle { radius_mm }, cond)
+    let table = common.table(&machine)?;
+    let comp = compensate(sp, table.as_ref(), &pose, &machine);
+    let rate = positive("rate-hz", common.rate_hz)?;
+    let run = match &comp {
+        Some(c) => simulate(&cl, c, rate)?,
+        None => simulate(&cl, sp, rate)?,
+    };
+    let correction = comp.as_ref().map(|c| corrections(c, &cl, &run));
+    write_output_files(
+        common,
+        &cl,
+        run,
+        PlotKind::Circle { radius_mm },
+        cond,
+        correction,
+    )
 }
 
 fn conditions(common: &Common, machine: &Machine, pose: &[f64]) -> Conditions {
@@ -255,18 +322,6 @@ fn conditions(common: &Common, machine: &Machine, pose: &[f64]) -> Conditions {
     }
 }
 
-fn write_run(
-    common: &Common,
-    cl: &ClosedLoop,
-    sp: &dyn SetPoint,
-    kind: PlotKind,
-    cond: Conditions,
-) -> anyhow::Result<()> {
-    let rate = positive("rate-hz", common.rate_hz)?;
-    let run = simulate(cl, sp, rate)?;
-    write_output_files(common, cl, run, kind, cond)
-}
-
 /// Writes the CSV (and the figure) of a finished run.
 fn write_output_files(
     common: &Common,
@@ -274,6 +329,7 @@ fn write_output_files(
     run: eij::sim::Run,
     kind: PlotKind,
     cond: Conditions,
+    correction: Option<Vec<f64>>,
 ) -> anyhow::Result<()> {
     if !(common.noise_um.is_finite() && common.noise_um >= 0.0) {
         bail!("--noise-um: {} must be ≥ 0", common.noise_um);
@@ -283,6 +339,7 @@ fn write_output_files(
         decimals: common.decimals,
         noise_um: common.noise_um,
         seed: common.seed,
+        correction,
     };
     let bytes = output::to_csv(cl, &run, &opts);
     let plot = match (&common.plot, kind) {
@@ -300,13 +357,12 @@ fn write_output_files(
             Some((path, move_svg(&data, &cond)?))
         }
     };
-    write_output(&common.out, &bytes, &[&common.machine.machine])?;
+    let inputs = common.inputs();
+    write_output(&common.out, &bytes, &inputs)?;
     if let Some((path, svg)) = plot {
-        write_output(
-            path,
-            svg.as_bytes(),
-            &[&common.machine.machine, &common.out],
-        )?;
+        let mut inputs = inputs;
+        inputs.push(&common.out);
+        write_output(path, svg.as_bytes(), &inputs)?;
     }
     Ok(())
 }

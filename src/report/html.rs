@@ -399,6 +399,7 @@ fn page(
         for (_, f) in moves {
             figure_html(&mut h, f);
         }
+        move_vs_circle_html(&mut h, &req.moves, moves, circles);
     }
     if let Some((rep, fig)) = ident {
         identification_html(&mut h, rep, fig);
@@ -411,6 +412,64 @@ fn page(
     }
     let _ = writeln!(h, "</body>\n</html>");
     h
+}
+
+/// EIJ of each move (`eij evaluate-move`) beside the mean of the circle tests that accelerate
+/// the same axis.
+fn move_vs_circle_html(
+    h: &mut String,
+    paths: &[PathBuf],
+    moves: &[(MoveData, Figure)],
+    circles: &[CircleEntry],
+) {
+    let _ = writeln!(
+        h,
+        "<h3>EIJ from the moves and from the circles</h3>\n<p class=\"note\">Move: external − \
+         internal against the set acceleration over the whole move (with velocity, constant and \
+         position terms; docs/compensation.md). Circles: mean over the circle tests above whose \
+         plane holds the moved axis. A move's acceleration spreads over 0–30 Hz, a circle's is \
+         one line near 8 Hz: they agree where the structure responds alike over that band.</p>"
+    );
+    let _ = writeln!(
+        h,
+        "<table>\n<tr><th>move</th><th>EIJ</th><th>move</th><th>± std err</th><th>circles (n)</th></tr>"
+    );
+    for (path, (data, _)) in paths.iter().zip(moves) {
+        let Ok(m) = crate::rtest::moves::evaluate_move(path, data.axis) else {
+            let _ = writeln!(
+                h,
+                "<tr><td>{}</td><td colspan=\"4\">no set acceleration to evaluate</td></tr>",
+                escape(&path.display().to_string())
+            );
+            continue;
+        };
+        for (e, v) in &m.eij {
+            let vals: Vec<f64> = circles
+                .iter()
+                .filter_map(|c| c.result.eij.get(e))
+                .copied()
+                .collect();
+            let circle = if vals.is_empty() {
+                "–".to_string()
+            } else {
+                format!(
+                    "{} ({})",
+                    fmt_eij(vals.iter().sum::<f64>() / vals.len() as f64),
+                    vals.len()
+                )
+            };
+            let _ = writeln!(
+                h,
+                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                escape(&path.display().to_string()),
+                e.name(),
+                fmt_eij(*v),
+                fmt_eij(m.std_err[e]),
+                circle
+            );
+        }
+    }
+    let _ = writeln!(h, "</table>");
 }
 
 fn circle_tables(h: &mut String, circles: &[CircleEntry]) {

@@ -31,8 +31,12 @@ pub struct MoveData {
     pub acc_set_m_s2: Vec<f64>,
     /// Actual acceleration of the moving axis (second derivative of the scale reading), m/s².
     pub acc_act_m_s2: Vec<f64>,
-    /// Cross-talk deviations ext − int of the other axes, µm.
+    /// Cross-talk deviations ext − int of the other axes, µm: the structural deviation, which is
+    /// the TCP's deviation from the path without compensation.
     pub cross_talk_um: Vec<(Axis, Vec<f64>)>,
+    /// For a compensated move (`<b>_comp_mm` columns), the TCP's deviation from the nominal
+    /// path ext − set of the other axes, µm: what remains with the compensation.
+    pub compensated_um: Vec<(Axis, Vec<f64>)>,
 }
 
 impl MoveData {
@@ -112,8 +116,22 @@ impl MoveData {
                 ))
             })
             .collect();
+        let compensated_um = Axis::ALL
+            .into_iter()
+            .filter(|&b| b != axis)
+            .filter_map(|b| {
+                column(&format!("{b}_comp_mm"))?;
+                let set = column(&format!("{b}_set_mm"))?;
+                let ext = column(&format!("{b}_ext_mm"))?;
+                Some((
+                    b,
+                    ext.iter().zip(&set).map(|(e, s)| (e - s) * 1e3).collect(),
+                ))
+            })
+            .collect();
         Ok(MoveData {
             axis,
+            compensated_um,
             set_mm: need("set_mm")?,
             int_mm: need("int_mm")?,
             acc_set_m_s2: need("acc_set_m_s2")?,
@@ -160,6 +178,7 @@ impl MoveData {
             acc_set_m_s2: get(format!("{axis}_acc_set_m_s2"), true, 1.0)?,
             acc_act_m_s2: get(format!("{axis}_acc_act_m_s2"), false, 1.0)?,
             cross_talk_um,
+            compensated_um: Vec::new(),
             source,
         })
     }
@@ -251,12 +270,40 @@ pub fn move_svg(data: &MoveData, cond: &Conditions) -> Result<String, ReportErro
             data.cross_talk_um
                 .iter()
                 .zip([svg::EXTERNAL, svg::SECOND])
-                .map(|((b, v), c)| (format!("d{b} = {b}_ext − {b}_int"), c, series(v)))
+                .map(|((b, v), c)| {
+                    let label = if data.compensated_um.is_empty() {
+                        format!("d{b} = {b}_ext − {b}_int")
+                    } else {
+                        format!("d{b} without compensation ({b}_ext − {b}_int)")
+                    };
+                    (label, c, series(v))
+                })
+                .chain(
+                    data.compensated_um
+                        .iter()
+                        .zip([svg::SET, svg::INTERNAL])
+                        .map(|((b, v), c)| {
+                            (
+                                format!("d{b} with compensation ({b}_ext − {b}_set)"),
+                                c,
+                                series(v),
+                            )
+                        }),
+                )
                 .collect(),
-            vec![
-                format!("cross-talk: TCP deviation of"),
-                format!("the other axes while {ax} moves"),
-            ],
+            if data.compensated_um.is_empty() {
+                vec![
+                    format!("cross-talk: TCP deviation of"),
+                    format!("the other axes while {ax} moves"),
+                ]
+            } else {
+                vec![
+                    format!("cross-talk while {ax} moves:"),
+                    format!("structural (= uncompensated)"),
+                    format!("and TCP − nominal path with"),
+                    format!("the compensation table"),
+                ]
+            },
         ),
     ];
     let header_px = 16 + 30 + 22 * lines.len() as u32 + 6;

@@ -46,6 +46,7 @@ pub mod iso230;
 pub mod json;
 pub mod layout;
 pub mod lstsq;
+pub mod moves;
 pub mod normalise;
 pub mod pooled;
 pub mod series;

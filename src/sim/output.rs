@@ -5,7 +5,8 @@
 //! `z_ext_mm` (TCP relative to the workpiece); then per machine axis `<a>_set_mm`,
 //! `<a>_vel_set_m_s`, `<a>_acc_set_m_s2` (set points exactly as fed to the model),
 //! `<a>_acc_act_m_s2` (second derivative of the scale reading), `<a>_following_error_um`,
-//! `<a>_torque_nm`.
+//! `<a>_torque_nm`; with a compensation ([`CsvOptions::correction`]) the set-point columns keep
+//! the nominal path and `<a>_comp_mm` follows each `<a>_set_mm` with the added correction.
 
 use super::Run;
 use crate::axes::Axis;
@@ -25,6 +26,10 @@ pub struct CsvOptions {
     pub noise_um: f64,
     /// Seed of the noise generator (ChaCha8: the same seed gives the same file everywhere).
     pub seed: u64,
+    /// A compensation added to the set points (sample-major, laid out like [`Run::inputs`]):
+    /// the set-point columns then show the nominal path (inputs minus correction) and
+    /// `<a>_comp_mm` the correction.
+    pub correction: Option<Vec<f64>>,
 }
 
 impl Default for CsvOptions {
@@ -34,6 +39,7 @@ impl Default for CsvOptions {
             decimals: 10,
             noise_um: 0.0,
             seed: 1,
+            correction: None,
         }
     }
 }
@@ -43,10 +49,11 @@ enum Source {
     Time,
     Output(usize, f64),
     Input(usize, f64),
+    Correction(usize, f64),
     Zero,
 }
 
-fn columns(cl: &ClosedLoop, required_only: bool) -> Vec<(String, Source)> {
+fn columns(cl: &ClosedLoop, required_only: bool, compensated: bool) -> Vec<(String, Source)> {
     let mut cols = vec![("t_s".to_string(), Source::Time)];
     let out = |name: &str, scale: f64| match cl.output(name) {
         Some(i) => Source::Output(i, scale),
@@ -67,6 +74,11 @@ fn columns(cl: &ClosedLoop, required_only: bool) -> Vec<(String, Source)> {
             None => Source::Zero,
         };
         cols.push((format!("{a}_set_mm"), inp(&format!("{a}_pos_set_m"), 1e3)));
+        if compensated {
+            if let Some(i) = cl.input(&format!("{a}_pos_set_m")) {
+                cols.push((format!("{a}_comp_mm"), Source::Correction(i, 1e3)));
+            }
+        }
         cols.push((
             format!("{a}_vel_set_m_s"),
             inp(&format!("{a}_vel_set_m_s"), 1.0),
@@ -94,7 +106,11 @@ fn columns(cl: &ClosedLoop, required_only: bool) -> Vec<(String, Source)> {
 /// The run as CSV text (comma separated, one header line, a fixed number of decimals, so that
 /// output is byte-identical across runs and machines).
 pub fn to_csv(cl: &ClosedLoop, run: &Run, opts: &CsvOptions) -> Vec<u8> {
-    let cols = columns(cl, opts.required_only);
+    let corr = opts
+        .correction
+        .as_deref()
+        .filter(|c| c.len() == run.inputs.len());
+    let cols = columns(cl, opts.required_only, corr.is_some());
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(opts.seed);
     let noise = Normal::new(0.0, opts.noise_um * 1e-3)
         .ok()
@@ -109,7 +125,11 @@ pub fn to_csv(cl: &ClosedLoop, run: &Run, opts: &CsvOptions) -> Vec<u8> {
             let mut v = match src {
                 Source::Time => run.t_s[k],
                 Source::Output(i, s) => run.outputs[k * run.ny + i] * s,
-                Source::Input(i, s) => run.inputs[k * run.nu + i] * s,
+                Source::Input(i, s) => {
+                    let c = corr.map_or(0.0, |c| c[k * run.nu + i]);
+                    (run.inputs[k * run.nu + i] - c) * s
+                }
+                Source::Correction(i, s) => corr.map_or(0.0, |c| c[k * run.nu + i]) * s,
                 Source::Zero => 0.0,
             };
             if let Some(n) = &noise {

@@ -1,0 +1,342 @@
+//! Compensation from a calibrated model: `eij compensation`, `eij simulate … --compensation`
+//! and `eij evaluate-move`, on the demo machine identified from the bundled measurements.
+
+use eij::axes::{Axis, Direction, Eij, Plane};
+use eij::compensation::CompensationTable;
+use eij::machine::Machine;
+use eij::predict::{simulated_eij, CircleTest, SimSettings};
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::sync::OnceLock;
+
+mod common;
+
+use common::{one_line_error, run, Scratch};
+
+/// The identified demo machine and its compensation table, made once for all tests.
+fn identified() -> &'static (Scratch, String, String) {
+    static CELL: OnceLock<(Scratch, String, String)> = OnceLock::new();
+    CELL.get_or_init(|| {
+        let s = Scratch::new("compensation");
+        let machine = s.s("id.toml");
+        let r = run(&["identify", "--quiet", "--no-design", "--out", &machine]);
+        assert!(r.ok, "{}", r.stderr);
+        let table = s.s("table.csv");
+        let r = run(&["compensation", "--machine", &machine, "--out", &table]);
+        assert!(r.ok, "{}", r.stderr);
+        (s, machine, table)
+    })
+}
+
+/// A CSV as columns by name.
+fn columns(path: &str) -> BTreeMap<String, Vec<f64>> {
+    let mut rdr = csv::Reader::from_path(path).unwrap();
+    let names: Vec<String> = rdr.headers().unwrap().iter().map(String::from).collect();
+    let mut cols: BTreeMap<String, Vec<f64>> = names.iter().map(|n| (n.clone(), vec![])).collect();
+    for rec in rdr.records() {
+        for (n, v) in names.iter().zip(rec.unwrap().iter()) {
+            cols.get_mut(n).unwrap().push(v.parse().unwrap());
+        }
+    }
+    cols
+}
+
+/// The paper's 20 mm Z move (30 000 mm/min, 10 m/s², 250 m/s³) at `pos`, with extra options.
+fn z_move(out: &str, pos: &str, extra: &[&str]) -> BTreeMap<String, Vec<f64>> {
+    let (_, machine, _) = identified();
+    let mut args = vec![
+        "simulate",
+        "move",
+        "--machine",
+        machine,
+        "--position-mm",
+        pos,
+        "--axis",
+        "z",
+        "--distance-mm",
+        "20",
+        "--feed-mm-min",
+        "30000",
+        "--accel-m-s2",
+        "10",
+        "--jerk-m-s3",
+        "250",
+        "--rate-hz",
+        "2000",
+        "--out",
+        out,
+    ];
+    args.extend_from_slice(extra);
+    let r = run(&args);
+    assert!(r.ok, "{}", r.stderr);
+    columns(out)
+}
+
+/// Largest |TCP − nominal path| of direction `a` over the move, µm.
+fn worst_um(c: &BTreeMap<String, Vec<f64>>, a: &str) -> f64 {
+    c[&format!("{a}_ext_mm")]
+        .iter()
+        .zip(&c[&format!("{a}_set_mm")])
+        .map(|(e, s)| (e - s).abs() * 1e3)
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn the_table_reproduces_the_models_eij_on_its_grid() {
+    // Independent of the table's own fit: simulate the EIJ at grid points afresh (the mean of
+    // the two planes that accelerate J) and compare with k_IJ(s_K) there; the difference may
+    // not exceed the worst residual the table states.
+    let (_, machine, table) = identified();
+    let m = Machine::from_file(Path::new(machine)).unwrap();
+    let t = CompensationTable::read(Path::new(table), &m).unwrap();
+    assert_eq!(t.coefficients.len(), 9);
+    let points = [
+        [-300.0, -250.0, -100.0],
+        [150.0, 0.0, 200.0],
+        [300.0, 250.0, 300.0],
+    ];
+    for p in points {
+        let pos: Vec<f64> = p.iter().map(|v| v * 1e-3).collect();
+        let tests: Vec<CircleTest> = Plane::ALL
+            .iter()
+            .map(|&pl| CircleTest::new(pl, Direction::Ccw, 2.0, 5.0).at(pos.clone()))
+            .collect();
+        let sims = simulated_eij(std::slice::from_ref(&m), &tests, &SimSettings::default())
+            .unwrap()
+            .remove(0);
+        for c in &t.coefficients {
+            let vals: Vec<f64> = sims
+                .iter()
+                .filter_map(|s| s.get(&c.parameter))
+                .copied()
+                .collect();
+            assert_eq!(vals.len(), 2, "{}", c.parameter);
+            let model = 0.5 * (vals[0] + vals[1]);
+            let d = (c.at(p) - model).abs();
+            assert!(
+                d <= c.worst_residual_um_s2_per_m + 1e-5,
+                "{} at {p:?}: table {:.5}, model {model:.5}, worst residual {}",
+                c.parameter,
+                c.at(p),
+                c.worst_residual_um_s2_per_m
+            );
+        }
+    }
+    // The table's cross-talk of the Z move: EXZ and EYZ are large and nearly constant.
+    let exz = t.get(Eij::new(Axis::X, Axis::Z)).unwrap();
+    assert!(exz.offset_um_s2_per_m < -0.3 && exz.worst_residual_um_s2_per_m < 0.01);
+}
+
+#[test]
+fn compensation_reduces_the_z_moves_cross_talk_tenfold_anywhere() {
+    let (s, _, table) = identified();
+    for pos in ["0,0,0", "150,-100,100"] {
+        let plain = z_move(&s.s("plain.csv"), pos, &[]);
+        let comp = z_move(&s.s("comp.csv"), pos, &["--compensation", table]);
+        // The nominal path is the same; the correction is its own column.
+        assert_eq!(plain["z_set_mm"], comp["z_set_mm"]);
+        assert_eq!(plain["x_set_mm"], comp["x_set_mm"]);
+        assert!(comp.contains_key("x_comp_mm") && !plain.contains_key("x_comp_mm"));
+        for a in ["x", "y"] {
+            let (before, after) = (worst_um(&plain, a), worst_um(&comp, a));
+            assert!(
+                before > 3.0,
+                "{pos}: {a} cross-talk {before} µm without compensation"
+            );
+            assert!(
+                after * 10.0 < before,
+                "{pos}: {a} cross-talk {before:.3} µm → {after:.3} µm with compensation"
+            );
+        }
+    }
+}
+
+#[test]
+fn the_correction_column_is_minus_k_times_the_set_acceleration() {
+    // Hand check at the sample of peak deceleration: comp_x = −k_XZ·a_z (+ −k_XX·a_x = 0).
+    let (s, machine, table) = identified();
+    let c = z_move(&s.s("hand.csv"), "0,0,0", &["--compensation", table]);
+    let m = Machine::from_file(Path::new(machine)).unwrap();
+    let t = CompensationTable::read(Path::new(table), &m).unwrap();
+    let a = &c["z_acc_set_m_s2"];
+    let k = (0..a.len()).min_by(|&i, &j| a[i].total_cmp(&a[j])).unwrap();
+    assert!(a[k] < -5.0);
+    let pos = [0.0, 0.0, c["z_set_mm"][k]];
+    let kxz = t.get(Eij::new(Axis::X, Axis::Z)).unwrap().at(pos);
+    let want_mm = -kxz * 1e-6 * a[k] * 1e3;
+    assert!(
+        (c["x_comp_mm"][k] - want_mm).abs() < 1e-9,
+        "{} vs {want_mm}",
+        c["x_comp_mm"][k]
+    );
+}
+
+#[test]
+fn move_eij_agree_with_circle_eij() {
+    // The move's acceleration is no single 8 Hz line (ramps of 40 ms, 0–30 Hz), but the
+    // structure's response is flat below its first modes, so both give the same EIJ within a
+    // few per cent (measured 1–2 %); the issue asks 25 % with the sign right.
+    let (s, machine, _) = identified();
+    let path = s.s("eval.csv");
+    z_move(&path, "0,0,0", &[]);
+    let r = run(&["evaluate-move", &path, "--axis", "z", "--json"]);
+    assert!(r.ok, "{}", r.stderr);
+    let v: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+    assert_eq!(v["axis"], "z");
+    let m = Machine::from_file(Path::new(machine)).unwrap();
+    let tests = [Plane::Yz, Plane::Zx].map(|p| CircleTest::new(p, Direction::Ccw, 2.0, 5.0));
+    let sims = simulated_eij(&[m], &tests, &SimSettings::default())
+        .unwrap()
+        .remove(0);
+    for dev in Axis::ALL {
+        let e = Eij::new(dev, Axis::Z);
+        let circle = 0.5 * (sims[0][&e] + sims[1][&e]);
+        let mv = v["eij_um_s2_per_m"][e.name()].as_f64().unwrap();
+        let se = v["std_err_um_s2_per_m"][e.name()].as_f64().unwrap();
+        assert!(se > 0.0 && se < 0.05, "{e}: std err {se}");
+        assert!(
+            mv.signum() == circle.signum() && ((mv - circle) / circle).abs() < 0.05,
+            "{e}: move {mv:.4}, circles {circle:.4}"
+        );
+    }
+}
+
+#[test]
+fn bad_tables_and_moves_are_refused_in_one_line() {
+    let (s, machine, table) = identified();
+    let good = std::fs::read_to_string(table).unwrap();
+    let bad = |name: &str, text: String, needles: &[&str]| {
+        let p = s.s(name);
+        std::fs::write(&p, text).unwrap();
+        let out_csv = s.s("never.csv");
+        let out = common::eij(&[
+            "simulate",
+            "move",
+            "--machine",
+            machine,
+            "--axis",
+            "z",
+            "--distance-mm",
+            "5",
+            "--feed-mm-min",
+            "6000",
+            "--accel-m-s2",
+            "2",
+            "--jerk-m-s3",
+            "100",
+            "--rate-hz",
+            "1000",
+            "--compensation",
+            &p,
+            "--out",
+            &out_csv,
+        ]);
+        one_line_error(&out, needles);
+        assert!(!Path::new(&out_csv).exists(), "{name}: output written");
+    };
+    bad(
+        "unknown.csv",
+        good.replace("EXY,", "EQY,"),
+        &["unknown.csv", "line", "unknown parameter 'EQY'"],
+    );
+    bad(
+        "units.csv",
+        good.replace("offset_um_s2_per_m", "offset_nm_s2_per_m"),
+        &["units.csv", "header", "unknown column 'offset_nm_s2_per_m'"],
+    );
+    let header = good.lines().next().unwrap();
+    bad(
+        "nan.csv",
+        format!("{header}\nEXY,none,NaN,0,0.1\n"),
+        &["nan.csv", "line 2", "not finite"],
+    );
+    bad(
+        "axis.csv",
+        good.replace("EXX,z,", "EXX,w,"),
+        &["axis.csv", "line 2", "adaptation_axis"],
+    );
+    let twice = format!("{good}{}", good.lines().nth(1).unwrap());
+    bad("twice.csv", twice, &["twice.csv", "given twice"]);
+    bad(
+        "huge.csv",
+        good.replace("EXY,none,-0.", "EXY,none,-1000000."),
+        &["huge.csv", "implausible"],
+    );
+    // An axis the machine lacks: the single-axis slide has no Z.
+    let p = s.s("noz.csv");
+    std::fs::write(
+        &p,
+        "parameter,adaptation_axis,offset_um_s2_per_m,slope_um_s2_per_m_per_mm\nEZX,none,0.1,0\n",
+    )
+    .unwrap();
+    let out = common::eij(&[
+        "simulate",
+        "move",
+        "--machine",
+        "machines/reference/single-axis.toml",
+        "--axis",
+        "x",
+        "--distance-mm",
+        "5",
+        "--feed-mm-min",
+        "6000",
+        "--accel-m-s2",
+        "2",
+        "--jerk-m-s3",
+        "100",
+        "--compensation",
+        &p,
+        "--out",
+        &s.s("never.csv"),
+    ]);
+    one_line_error(&out, &["noz.csv", "line 2", "has no axis z"]);
+    // A move file without the moved axis's set point, and a file that is no move.
+    let p = s.s("noset.csv");
+    std::fs::write(&p, format!("{}\n0,0,0,0,0,0,0\n", common::HEADER)).unwrap();
+    one_line_error(
+        &common::eij(&["evaluate-move", &p, "--axis", "z"]),
+        &["noset.csv", "z_acc_set_m_s2"],
+    );
+}
+
+#[test]
+fn the_report_shows_the_compensated_move_and_move_against_circle_eij() {
+    let (s, _, table) = identified();
+    let (plain, comp) = (s.s("rep-plain.csv"), s.s("rep-comp.csv"));
+    z_move(&plain, "0,0,0", &[]);
+    z_move(&comp, "0,0,0", &["--compensation", table]);
+    let out = s.s("report");
+    let r = run(&[
+        "report",
+        "--measured",
+        "measurements/demo-vmc/pos-a",
+        "--move",
+        &plain,
+        "--move",
+        &comp,
+        "--out",
+        &out,
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    let html = std::fs::read_to_string(Path::new(&out).join("report.html")).unwrap();
+    assert!(html.contains("EIJ from the moves and from the circles"));
+    // Both moves give EXZ near the circles' mean, in the table's rows.
+    assert_eq!(html.matches("<td>EXZ</td>").count(), 2, "{html}");
+    let svgs: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| {
+            p.file_name()
+                .unwrap()
+                .to_string_lossy()
+                .starts_with("move-")
+        })
+        .map(|p| std::fs::read_to_string(p).unwrap())
+        .collect();
+    assert_eq!(svgs.len(), 2);
+    let with = svgs
+        .iter()
+        .filter(|t| t.contains("with compensation"))
+        .count();
+    assert_eq!(with, 1, "one move figure shows the compensated deviation");
+}
