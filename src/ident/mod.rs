@@ -40,12 +40,14 @@ pub mod measured;
 pub mod parameters;
 pub mod problem;
 pub mod report;
+mod rounds;
 pub mod settings;
 mod solve;
 pub mod statics;
 pub mod stiffness;
 pub mod uncertainty;
 pub mod validation;
+mod verdict;
 
 pub use crate::predict::{EijMap, SolverKind};
 pub use builder::Identification;
@@ -60,9 +62,6 @@ pub use uncertainty::Uncertainty;
 use crate::machine::Machine;
 use nalgebra::{DMatrix, DVector};
 use parameters::to_factor;
-use problem::Reduced;
-use settings::{AT_BOUND_REL, CHI2_SIGMAS, PLAUSIBLE_MAX, PLAUSIBLE_MIN};
-use std::borrow::Cow;
 use std::sync::{Arc, Mutex};
 
 /// Called after every iteration with (iteration, cost = Σr²).
@@ -81,7 +80,7 @@ pub struct Identified {
     pub std_err: Option<f64>,
     /// Whether the tests determine it.
     pub identifiable: bool,
-    /// Whether it ended on a bound of the factors (within [`AT_BOUND_REL`] of it, relative).
+    /// Whether it ended on a bound of the factors (within [`settings::AT_BOUND_REL`] of it, relative).
     pub at_bound: bool,
 }
 
@@ -164,159 +163,6 @@ impl IdentResult {
     }
 }
 
-/// Fits the free parameters from `start` (θ of all parameters): (θ, iterations, converged).
-fn fit(
-    problem: &Problem,
-    free: &[usize],
-    start: &DVector<f64>,
-    costs: Arc<Mutex<Vec<f64>>>,
-    progress: Option<Arc<ProgressFn>>,
-) -> Result<(DVector<f64>, u64, bool), IdentError> {
-    let x0 = DVector::from_iterator(free.len(), free.iter().map(|&i| start[i]));
-    let cost0 = costs
-        .lock()
-        .ok()
-        .and_then(|c| c.last().copied())
-        .unwrap_or(1.0);
-    let reduced = Reduced {
-        problem,
-        free: free.to_vec(),
-        base: start.clone(),
-    };
-    let (x, iterations, converged) = solve::optimise(reduced, x0, cost0, costs, progress)?;
-    let mut theta = start.clone();
-    for (k, &i) in free.iter().enumerate() {
-        theta[i] = x[k];
-    }
-    Ok((theta, iterations, converged))
-}
-
-/// The groups whose reversal terms lower χ² by more than [`CHI2_SIGMAS`] standard deviations
-/// of a χ²_k (k terms) — scaled by s² where s > 1 — at θ.
-fn reversal_needed(
-    problem: &Problem,
-    theta: &DVector<f64>,
-    free: usize,
-) -> Result<Vec<usize>, IdentError> {
-    let statics = problem.statics();
-    let candidates: Vec<usize> = (0..statics.groups.len())
-        .filter(|&g| {
-            let gr = &statics.groups[g];
-            gr.shared && gr.reversal_possible && !gr.reversal
-        })
-        .collect();
-    if candidates.is_empty() {
-        return Ok(Vec::new());
-    }
-    let r = problem.residuals_at(theta)?;
-    let s2 = (r.norm_squared() / problem.dof(free).max(1) as f64).max(1.0);
-    Ok(candidates
-        .into_iter()
-        .filter(|&g| {
-            let (gain, k) = statics.reversal_gain(g, problem.rows(), &r);
-            let k = k as f64;
-            k > 0.0 && gain / s2 > k + CHI2_SIGMAS * (2.0 * k).sqrt()
-        })
-        .collect())
-}
-
-/// Re-checks identifiability at the solution θ (the operating point matters: a compliance
-/// weakly seen from the catalogue values may be determined at the solution, or the reverse)
-/// with the Jacobian of the weighted errors `e_jac`, over all parameters. Returns true when the
-/// set of free parameters stays; else updates `analysis` (with a note), resets the newly held
-/// parameters in `theta` to their start values `theta0` and returns false: fit again. A set
-/// seen before (the rounds would oscillate) is replaced by the parameters free in both of the
-/// last two sets, fitted once more; `history` holds the sets tried, at most [`MAX_ROUNDS`].
-fn rounds_left(
-    analysis: &mut identifiability::Analysis,
-    history: &mut Vec<Vec<usize>>,
-    problem: &Problem,
-    e_jac: &DMatrix<f64>,
-    theta: &mut DVector<f64>,
-    theta0: &DVector<f64>,
-    names: &[String],
-    notes: &mut Vec<String>,
-) -> bool {
-    if history.len() > MAX_ROUNDS || history.last() != Some(&analysis.free) {
-        return true;
-    }
-    let mut again = identifiability::analyse(&problem.statics().project_matrix(e_jac), theta);
-    if again.free == analysis.free {
-        return true;
-    }
-    if history.contains(&again.free) || history.len() == MAX_ROUNDS {
-        // Oscillating: keep what both agree on.
-        let both: Vec<usize> = again
-            .free
-            .iter()
-            .copied()
-            .filter(|i| analysis.free.contains(i))
-            .collect();
-        let held: Vec<usize> = again
-            .free
-            .iter()
-            .chain(&analysis.free)
-            .copied()
-            .filter(|i| !both.contains(i))
-            .collect();
-        for &i in &held {
-            if !again.not_identifiable.iter().any(|n| n.index == i) {
-                let kept = analysis.not_identifiable.iter().find(|n| n.index == i);
-                again.not_identifiable.extend(kept.cloned());
-            }
-        }
-        again.free = both;
-        history.push(Vec::new());
-    } else {
-        history.push(again.free.clone());
-    }
-    if again.free.is_empty() {
-        return true;
-    }
-    let list = |v: Vec<usize>| -> String {
-        v.into_iter()
-            .map(|i| names[i].clone())
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
-    let released: Vec<usize> = again
-        .free
-        .iter()
-        .copied()
-        .filter(|i| !analysis.free.contains(i))
-        .collect();
-    let held: Vec<usize> = analysis
-        .free
-        .iter()
-        .copied()
-        .filter(|i| !again.free.contains(i))
-        .collect();
-    for &i in &held {
-        theta[i] = theta0[i];
-    }
-    notes.push(format!(
-        "identifiability at the solution differs from that at the start values{}{}: fitted again",
-        if released.is_empty() {
-            String::new()
-        } else {
-            format!("; determined now: {}", list(released))
-        },
-        if held.is_empty() {
-            String::new()
-        } else {
-            format!(
-                "; not determined now (back to the start value): {}",
-                list(held)
-            )
-        },
-    ));
-    *analysis = again;
-    false
-}
-
-/// Rounds of fitting with a changed set of free parameters.
-const MAX_ROUNDS: usize = 3;
-
 /// Runs the identification (see the module docs for the order of its steps). Errors are
 /// what prevents a fit at all (no data, no parameter the tests see, a start that cannot be
 /// simulated); a fit that ends on a bound or does not converge is returned with
@@ -328,48 +174,14 @@ pub fn identify(
     let s = problem.settings();
     let evaluations_before = problem.evaluations();
     let theta0 = problem.initial_theta();
-    let (j0, r0) = problem.jacobian_at(&theta0)?;
-    let m = r0.len();
     let names: Vec<String> = problem
         .parameters()
         .iter()
         .map(|p| p.name.clone())
         .collect();
+    let (j0, r0) = problem.jacobian_at(&theta0)?;
     let mut analysis = identifiability::analyse(&j0, &theta0);
-    if analysis.free.is_empty() {
-        let no_influence = analysis.not_identifiable.iter().all(|n| n.no_influence);
-        let why: Vec<String> = analysis
-            .not_identifiable
-            .iter()
-            .map(|ni| ni.describe(&names, to_factor(theta0[ni.index])))
-            .collect();
-        return Err(IdentError::NoData(if no_influence {
-            "none of the parameters influences the measured EIJ: no overlap between parameters and tests".into()
-        } else {
-            format!(
-                "the tests determine none of the parameters: {}",
-                why.join("; ")
-            )
-        }));
-    }
-    // Enough values for every parameter the tests see (ties are the analysis's business)?
-    let seen = analysis.free.len()
-        + analysis
-            .not_identifiable
-            .iter()
-            .filter(|n| !n.no_influence)
-            .count();
-    if problem.dof(seen) == 0 || problem.dof(analysis.free.len()) == 0 {
-        let q = problem.statics().rank();
-        return Err(IdentError::NoData(format!(
-            "{m} measured values cannot determine {seen} parameters{}",
-            if q > 0 {
-                format!(" and {q} static terms")
-            } else {
-                String::new()
-            }
-        )));
-    }
+    verdict::check_start(problem, &analysis, &theta0, &names, r0.len())?;
     let mut notes: Vec<String> = problem
         .statics()
         .groups
@@ -378,170 +190,63 @@ pub fn identify(
         .collect();
     // Cost history: the start, then after every iteration.
     let costs = Arc::new(Mutex::new(vec![r0.norm_squared()]));
-    let mut current = Cow::Borrowed(problem);
-    let mut theta = theta0.clone();
-    let mut iterations = 0;
-    let mut reversal_checked = s.static_terms != StaticTerms::Auto;
-    let mut history = vec![analysis.free.clone()];
-    // Fit; add reversal terms where the data need them; re-check identifiability at the
-    // solution (a parameter hidden at the start may be determined once the others are fitted,
-    // or the reverse) and fit again with the new set, a few rounds at most.
-    let (converged, e_jac, e, edges) = loop {
-        let free = analysis.free.clone();
-        let (t, it, converged) = fit(&current, &free, &theta, costs.clone(), progress.clone())?;
-        (theta, iterations) = (t, iterations + it);
-        if converged && !reversal_checked {
-            reversal_checked = true;
-            let need = reversal_needed(&current, &theta, free.len())?;
-            if !need.is_empty() {
-                let with = current.with_statics(current.statics_with(&need));
-                for &g in &need {
-                    notes.push(format!(
-                        "reversal terms (static, sign flipping with the direction) fitted at {}: the data need them",
-                        with.statics().groups[g].label()
-                    ));
-                }
-                current = Cow::Owned(with);
-                continue;
-            }
-        }
-        let (e_jac, e, edges) = current.error_jacobian_edges(&theta)?;
-        let settled = !converged
-            || rounds_left(
-                &mut analysis,
-                &mut history,
-                &current,
-                &e_jac,
-                &mut theta,
-                &theta0,
-                &names,
-                &mut notes,
-            );
-        if settled {
-            break (converged, e_jac, e, edges);
-        }
-    };
-    let free = analysis.free.clone();
+    let fitted = rounds::fit_in_rounds(
+        problem,
+        &mut analysis,
+        &theta0,
+        &names,
+        &mut notes,
+        costs.clone(),
+        progress,
+    )?;
+    let problem: &Problem = &fitted.problem;
+    let theta = &fitted.theta;
+    let free = &analysis.free;
+    let refusal = verdict::refusal(
+        s,
+        fitted.converged,
+        fitted.iterations,
+        theta,
+        free,
+        &fitted.edges,
+        &names,
+    );
     let mut warnings: Vec<String> = analysis
         .not_identifiable
         .iter()
         .map(|ni| ni.describe(&names, to_factor(theta0[ni.index])))
         .collect();
-    let problem: &Problem = &current;
-    let (lo, hi) = (s.min_factor, s.max_factor);
-    let at_bound = |i: usize| {
-        let p = to_factor(theta[i]);
-        (p - lo).abs() <= AT_BOUND_REL * lo || (p - hi).abs() <= AT_BOUND_REL * hi
-    };
-    let refusal = if !converged {
-        Some(IdentError::NotConverged { iterations })
-    } else {
-        free.iter().find(|&&i| at_bound(i)).map(|&i| {
-            let p = to_factor(theta[i]);
-            IdentError::AtBound {
-                name: names[i].clone(),
-                value: p,
-                bound: if (p - lo).abs() < (p - hi).abs() {
-                    lo
-                } else {
-                    hi
-                },
-                min: lo,
-                max: hi,
-            }
-        })
-    };
-    let edges: Vec<usize> = edges.into_iter().filter(|i| free.contains(i)).collect();
-    let refusal = refusal.or_else(|| {
-        (!edges.is_empty()).then(|| {
-            let at: Vec<String> = edges
-                .iter()
-                .map(|&i| format!("{} = {:.4}", names[i], to_factor(theta[i])))
-                .collect();
-            let step = problem.settings().fd_step;
-            IdentError::AtSimulationLimit {
-                names: at.join(", "),
-                detail: format!("a change of {step} relative makes a simulation fail, e.g. an unstable closed loop"),
-            }
-        })
-    });
-    let j_all = problem.statics().project_matrix(&e_jac);
-    let r = problem.statics().project(&e);
-    let j = DMatrix::from_fn(m, free.len(), |row, c| j_all[(row, free[c])]);
-    let cost_final = r.norm_squared();
-    let free_names: Vec<&str> = free.iter().map(|&i| names[i].as_str()).collect();
-    let free_theta: Vec<f64> = free.iter().map(|&i| theta[i]).collect();
-    let dof = problem.dof(free.len());
-    let u = Uncertainty::at(&j, cost_final, &free_theta, &free_names, dof)?;
-    warnings.extend(u.warnings.iter().cloned());
-    let e_free = DMatrix::from_fn(m, free.len(), |row, c| e_jac[(row, free[c])]);
-    let static_estimates = problem
-        .statics()
-        .estimates(&e, &e_free, &u.covariance, u.residual_std.powi(2))
-        .into_iter()
-        .zip(&problem.statics().columns)
-        .map(|((v, se), c)| StaticEstimate {
-            group: c.group,
-            eij: c.eij,
-            reversal: c.reversal,
-            clock: c.clock,
-            value_um_per_mm: v,
-            std_err_um_per_mm: se,
-        })
-        .collect();
-    let n = theta0.len();
-    let mut correlation = DMatrix::zeros(n, n);
-    for (a, &i) in free.iter().enumerate() {
-        for (b, &k) in free.iter().enumerate() {
-            correlation[(i, k)] = u.correlation[(a, b)];
-        }
-    }
-    let parameters: Vec<Identified> = problem
-        .parameters()
+    let fit = FitUncertainty::at(problem, &fitted.e_jac, &fitted.e, theta, free)?;
+    warnings.extend(fit.uncertainty.warnings.iter().cloned());
+    let parameters: Vec<Identified> = names
         .iter()
         .enumerate()
-        .map(|(i, p)| {
+        .map(|(i, name)| {
             let fi = free.iter().position(|&f| f == i);
             Identified {
-                name: p.name.clone(),
+                name: name.clone(),
                 initial: to_factor(theta0[i]),
                 value: to_factor(theta[i]),
-                std_err: fi.map(|k| u.std_err[k]),
+                std_err: fi.map(|k| fit.uncertainty.std_err[k]),
                 identifiable: fi.is_some(),
-                at_bound: fi.is_some() && at_bound(i),
+                at_bound: fi.is_some() && verdict::on_bound(to_factor(theta[i]), s),
             }
         })
         .collect();
-    for q in parameters.iter().filter(|q| q.identifiable) {
-        if q.at_bound {
-            warnings.push(format!(
-                "{} = {} ended on a bound of the factors [{lo}, {hi}]: the data want a value outside",
-                q.name, q.value
-            ));
-        } else if q.value > PLAUSIBLE_MAX {
-            warnings.push(format!(
-                "{} = {:.4} > {PLAUSIBLE_MAX}: stiffer than its catalogue data, implausible for a reduction factor (a compliance missing elsewhere in the model, or a data problem)",
-                q.name, q.value
-            ));
-        } else if q.value < PLAUSIBLE_MIN {
-            warnings.push(format!(
-                "{} = {:.4} < {PLAUSIBLE_MIN}: more than ten times softer than its catalogue data, implausible (a compliance missing elsewhere in the model, or a data problem)",
-                q.name, q.value
-            ));
-        }
-    }
+    warnings.extend(verdict::plausibility(&parameters, s));
     let mut sims = problem.simulate_many(&[theta0.clone(), theta.clone()])?;
     let simulated_final = sims.pop().unwrap_or_default();
     let simulated_initial = sims.pop().unwrap_or_default();
     let simulated_final_time = if s.simulation.solver == SolverKind::Harmonic && refusal.is_none() {
-        let (time, warning) = solve::confirm_in_time_domain(problem, &theta, &simulated_final)?;
+        let (time, warning) = solve::confirm_in_time_domain(problem, theta, &simulated_final)?;
         warnings.extend(warning);
         Some(time)
     } else {
         None
     };
     let design = if s.design {
-        Some(design::rank(problem, &theta, &e_jac, u.residual_std)?)
+        let s_res = fit.uncertainty.residual_std;
+        Some(design::rank(problem, theta, &fitted.e_jac, s_res)?)
     } else {
         None
     };
@@ -555,25 +260,86 @@ pub fn identify(
     Ok(IdentResult {
         parameters,
         not_identifiable: analysis.not_identifiable,
-        correlation,
-        singular_values: u.singular_values,
+        correlation: fit.correlation,
+        singular_values: fit.uncertainty.singular_values,
         cost_initial: r0.norm_squared(),
-        cost_final,
+        cost_final: fit.cost,
         cost_history,
-        residual_std: u.residual_std,
-        residuals: m,
-        iterations,
+        residual_std: fit.uncertainty.residual_std,
+        residuals: r0.len(),
+        iterations: fitted.iterations,
         evaluations: problem.evaluations() - evaluations_before,
         rejected_steps,
         simulated_initial,
         simulated_final,
         simulated_final_time,
         statics: problem.statics().clone(),
-        static_estimates,
+        static_estimates: fit.static_estimates,
         design,
         warnings,
         notes,
         refusal,
-        machine: problem.machine_at(&theta)?,
+        machine: problem.machine_at(theta)?,
     })
+}
+
+/// The uncertainty of a fit at θ over the free parameters, with the static terms eliminated.
+struct FitUncertainty {
+    /// Σr² of the projected residuals.
+    cost: f64,
+    /// Standard errors, correlations, singular values and their warnings (free parameters).
+    uncertainty: Uncertainty,
+    /// Correlation matrix over all parameters (held ones 0).
+    correlation: DMatrix<f64>,
+    /// The static terms' estimates.
+    static_estimates: Vec<StaticEstimate>,
+}
+
+impl FitUncertainty {
+    fn at(
+        problem: &Problem,
+        e_jac: &DMatrix<f64>,
+        e: &DVector<f64>,
+        theta: &DVector<f64>,
+        free: &[usize],
+    ) -> Result<Self, IdentError> {
+        let m = e.len();
+        let names: Vec<&str> = free
+            .iter()
+            .map(|&i| problem.parameters()[i].name.as_str())
+            .collect();
+        let j_all = problem.statics().project_matrix(e_jac);
+        let cost = problem.statics().project(e).norm_squared();
+        let j = DMatrix::from_fn(m, free.len(), |row, c| j_all[(row, free[c])]);
+        let free_theta: Vec<f64> = free.iter().map(|&i| theta[i]).collect();
+        let u = Uncertainty::at(&j, cost, &free_theta, &names, problem.dof(free.len()))?;
+        let e_free = DMatrix::from_fn(m, free.len(), |row, c| e_jac[(row, free[c])]);
+        let static_estimates = problem
+            .statics()
+            .estimates(e, &e_free, &u.covariance, u.residual_std.powi(2))
+            .into_iter()
+            .zip(&problem.statics().columns)
+            .map(|((v, se), c)| StaticEstimate {
+                group: c.group,
+                eij: c.eij,
+                reversal: c.reversal,
+                clock: c.clock,
+                value_um_per_mm: v,
+                std_err_um_per_mm: se,
+            })
+            .collect();
+        let n = theta.len();
+        let mut correlation = DMatrix::zeros(n, n);
+        for (a, &i) in free.iter().enumerate() {
+            for (b, &k) in free.iter().enumerate() {
+                correlation[(i, k)] = u.correlation[(a, b)];
+            }
+        }
+        Ok(FitUncertainty {
+            cost,
+            uncertainty: u,
+            correlation,
+            static_estimates,
+        })
+    }
 }

@@ -1,6 +1,6 @@
 //! The identification problem: measured tests, the parameters fitted to them, weighted
 //! residuals r = P·(E_sim − E_meas)/σ (P eliminates the static terms, see [`super::statics`])
-//! and their central-difference Jacobian, and the problem as argmin sees it ([`Reduced`]:
+//! and their central-difference Jacobian, and the problem as argmin sees it (`Reduced`:
 //! residual operator, Jacobian and cost over the free parameters; a trial point whose closed
 //! loop cannot be simulated has infinite cost, so that the optimiser rejects the step).
 
