@@ -20,6 +20,24 @@ pub fn evaluate(e: RtestError) -> anyhow::Error {
     }
 }
 
+/// A warning of the evaluation with the option that answers it.
+pub fn evaluate_warning(w: &str) -> String {
+    if w.starts_with("no set radius given") {
+        format!("{w}; give --radius-mm")
+    } else {
+        w.to_string()
+    }
+}
+
+/// A warning of the measured data read by `eij identify`, with the option that answers it.
+pub fn identify_warning(w: &str) -> String {
+    if w.contains("no set radius in the test's conditions") {
+        format!("{w}; give --radius-mm or radius_mm in rtest.toml")
+    } else {
+        w.to_string()
+    }
+}
+
 /// `eij identify` and `eij verify`: where the settings come from, and that nothing is exported
 /// after a failed fit.
 pub fn identify(e: IdentError) -> anyhow::Error {

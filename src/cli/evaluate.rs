@@ -128,7 +128,11 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<()> {
         .iter()
         .flat_map(|t| t.result.warnings.iter().map(move |w| (t, w)))
     {
-        eprintln!("eij: warning: {}: {}", w.0.input.name(), w.1);
+        eprintln!(
+            "eij: warning: {}: {}",
+            w.0.input.name(),
+            super::advice::evaluate_warning(w.1)
+        );
     }
     for w in &suite.warnings {
         eprintln!("eij: warning: {w}");

@@ -255,7 +255,12 @@ fn run_identification(prep: &Prepared, quiet: bool) -> anyhow::Result<(IdentResu
         b.finish_and_clear();
     }
     let mut result = result.map_err(super::advice::identify)?;
-    result.warnings.splice(0..0, prep.warnings.iter().cloned());
+    result.warnings.splice(
+        0..0,
+        prep.warnings
+            .iter()
+            .map(|w| super::advice::identify_warning(w)),
+    );
     for w in &result.warnings {
         eprintln!("warning: {w}");
     }

@@ -257,16 +257,16 @@ fn condition_warnings(input: &TestInput, r: &CircleResult, source: RadiusSource)
     let mut w = Vec::new();
     if source == RadiusSource::InternalMean {
         w.push(format!(
-            "no set radius given (--radius-mm or rtest.toml radius_mm): EIJ are per the \
-             acceleration of the mean internal radius {:.4} mm, not per set acceleration",
+            "no set radius given (rtest.toml radius_mm, or a set radius with the evaluation's \
+             options): EIJ are per the acceleration of the mean internal radius {:.4} mm, not per set acceleration",
             r.radius_mm
         ));
     }
     if source == RadiusSource::Fallback {
         w.push(format!(
             "no set radius in the test's conditions (rtest.toml radius_mm or [[test]]): the \
-             caller's radius {:.4} mm (identify: --radius-mm or config radius_mm, default 2 mm) is taken as the \
-             set radius; the data's mean internal radius is {:.4} mm",
+             identification's default radius {:.4} mm (its settings' radius_mm, 2 mm unless set) is taken \
+             as the set radius; the data's mean internal radius is {:.4} mm",
             r.radius_mm, r.measured_radius_mm
         ));
     }
