@@ -29,6 +29,7 @@
 //! (reading measured EIJ), [`config`] and [`report`] (files), and [`identify`], which runs them
 //! in order; [`stiffness`] gives the identified stiffness set as a table.
 
+mod acceptance;
 mod builder;
 pub mod config;
 pub mod design;
@@ -47,7 +48,6 @@ pub mod statics;
 pub mod stiffness;
 pub mod uncertainty;
 pub mod validation;
-mod verdict;
 
 pub use crate::predict::{EijMap, SolverKind};
 pub use builder::Identification;
@@ -181,7 +181,7 @@ pub fn identify(
         .collect();
     let (j0, r0) = problem.jacobian_at(&theta0)?;
     let mut analysis = identifiability::analyse(&j0, &theta0);
-    verdict::check_start(problem, &analysis, &theta0, &names, r0.len())?;
+    acceptance::check_start(problem, &analysis, &theta0, &names, r0.len())?;
     let mut notes: Vec<String> = problem
         .statics()
         .groups
@@ -202,7 +202,7 @@ pub fn identify(
     let problem: &Problem = &fitted.problem;
     let theta = &fitted.theta;
     let free = &analysis.free;
-    let refusal = verdict::refusal(
+    let refusal = acceptance::refusal(
         s,
         fitted.converged,
         fitted.iterations,
@@ -229,11 +229,11 @@ pub fn identify(
                 value: to_factor(theta[i]),
                 std_err: fi.map(|k| fit.uncertainty.std_err[k]),
                 identifiable: fi.is_some(),
-                at_bound: fi.is_some() && verdict::on_bound(to_factor(theta[i]), s),
+                at_bound: fi.is_some() && acceptance::on_bound(to_factor(theta[i]), s),
             }
         })
         .collect();
-    warnings.extend(verdict::plausibility(&parameters, s));
+    warnings.extend(acceptance::plausibility(&parameters, s));
     let mut sims = problem.simulate_many(&[theta0.clone(), theta.clone()])?;
     let simulated_final = sims.pop().unwrap_or_default();
     let simulated_initial = sims.pop().unwrap_or_default();

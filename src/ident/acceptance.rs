@@ -1,4 +1,4 @@
-//! The verdict on a fit: whether the identification may start at all, whether its result may be
+//! The acceptance of a fit: whether the identification may start at all, whether its result may be
 //! exported (converged, off the bounds, away from the limit of what the model can simulate),
 //! and the plausibility of the identified factors.
 
