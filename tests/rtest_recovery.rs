@@ -164,37 +164,6 @@ fn servo_lag_does_not_leak_into_cross_talk() {
     }
 }
 
-/// Timing printout (not a timed test): one evaluation of a ~10k-sample series.
-#[test]
-fn evaluation_time_of_a_10k_series() {
-    let mut syn = Synth::new(Plane::Xy, true, 5.0);
-    syn.steady_revs = 75.5;
-    let series = syn.series();
-    let opts = EvalOptions::default();
-    let r = evaluate(&series, &opts).unwrap();
-    let reps = 20;
-    let start = std::time::Instant::now();
-    for _ in 0..reps {
-        std::hint::black_box(evaluate(&series, &opts).unwrap());
-    }
-    let per = start.elapsed() / reps;
-    println!(
-        "evaluate: {} samples ({} used): {:?} per evaluation",
-        series.len(),
-        r.samples_used,
-        per
-    );
-    let start = std::time::Instant::now();
-    for _ in 0..reps {
-        std::hint::black_box(eij::rtest::evaluate_joint(&series, &opts).unwrap());
-    }
-    println!(
-        "evaluate_joint: {:?} per evaluation",
-        start.elapsed() / reps
-    );
-    assert!(series.len() > 10_000);
-}
-
 /// A set radius that is no positive number is refused, not used.
 #[test]
 fn bad_set_radius_is_refused() {
