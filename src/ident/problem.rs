@@ -5,6 +5,7 @@
 //! loop cannot be simulated has infinite cost, so that the optimiser rejects the step).
 
 use super::parameters::{to_factor, to_theta, Parameter};
+use super::settings::SIMULATION_RESOLUTION;
 use super::statics::{Row, Statics};
 use super::{IdentError, Settings};
 use crate::axes::Eij;
@@ -347,6 +348,26 @@ impl Problem {
         )
     }
 
+    /// (E_a − E_b)/σ in the order of [`Problem::rows`], a difference within the simulation's
+    /// rounding ([`SIMULATION_RESOLUTION`] of the test's largest EIJ) taken as none: a
+    /// parameter that no test sees then has an exactly zero Jacobian column.
+    fn weighted_difference(&self, a: &[EijMap], b: &[EijMap]) -> DVector<f64> {
+        let largest = |s: &[EijMap], t: usize| s[t].values().fold(0.0_f64, |m, v| m.max(v.abs()));
+        DVector::from_iterator(
+            self.rows.len(),
+            self.rows.iter().map(|row| {
+                let get = |s: &[EijMap]| s[row.test].get(&row.eij).copied().unwrap_or(f64::NAN);
+                let (x, y) = (get(a), get(b));
+                let scale = largest(a, row.test).max(largest(b, row.test));
+                if (x - y).abs() <= SIMULATION_RESOLUTION * scale {
+                    0.0
+                } else {
+                    (x - y) / row.sigma
+                }
+            }),
+        )
+    }
+
     /// Residuals r = P·(E_sim − E_meas)/σ: the weighted errors without the static terms.
     pub fn residuals_of(&self, sims: &[EijMap]) -> DVector<f64> {
         self.statics.project(&self.errors_of(sims))
@@ -399,7 +420,8 @@ impl Problem {
             }
         }
         let sims = self.simulate_each(&thetas);
-        let r0 = self.errors_of(&sims[0].clone()?);
+        let centre = sims[0].clone()?;
+        let r0 = self.errors_of(&centre);
         let mut j = DMatrix::zeros(r0.len(), theta.len());
         let mut edges = Vec::new();
         for i in 0..theta.len() {
@@ -409,11 +431,9 @@ impl Problem {
             // Central difference; one-sided where the other side cannot be simulated (a
             // neighbour beyond the closed loop's stability limit).
             let column = match (&sims[1 + 2 * i], &sims[2 + 2 * i]) {
-                (Ok(plus), Ok(minus)) => {
-                    (self.errors_of(plus) - self.errors_of(minus)) / (2.0 * h[i])
-                }
-                (Ok(plus), Err(_)) => (self.errors_of(plus) - &r0) / h[i],
-                (Err(_), Ok(minus)) => (&r0 - self.errors_of(minus)) / h[i],
+                (Ok(plus), Ok(minus)) => self.weighted_difference(plus, minus) / (2.0 * h[i]),
+                (Ok(plus), Err(_)) => self.weighted_difference(plus, &centre) / h[i],
+                (Err(_), Ok(minus)) => self.weighted_difference(&centre, minus) / h[i],
                 (Err(e), Err(_)) => return Err(e.clone()),
             };
             j.set_column(i, &column);

@@ -115,6 +115,12 @@ impl Default for MeasuredOptions {
     }
 }
 
+/// Simulated EIJ that differ by less than this fraction of the test's largest EIJ differ by
+/// rounding only (the harmonic simulation resolves ~1e-13 relative; a reduction factor that a test
+/// sees moves its EIJ by far more over a finite-difference step): their difference counts as
+/// zero in the Jacobian.
+pub const SIMULATION_RESOLUTION: f64 = 1e-10;
+
 /// A parameter whose Jacobian column norm at the start is below this fraction of the largest
 /// is not seen by the tests: it is kept at its start value and reported not identifiable.
 pub const UNIDENTIFIABLE_COLUMN: f64 = 1e-6;
