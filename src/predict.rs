@@ -3,7 +3,8 @@
 //! A circle test is simulated on the closed loop assembled at its circle centre ([`crate::sim`],
 //! harmonic steady state or time domain) and the simulated series is evaluated by the very
 //! evaluation that serves measured series ([`crate::rtest::evaluate_joint`]), so that model and
-//! measurement are compared like with like. This stage sits between `sim`/`rtest` and its users:
+//! measurement are compared like with like; a harmonic steady state is evaluated by that
+//! evaluation's closed form ([`crate::rtest::harmonic`], equal to the sampled route to 1e-9). This stage sits between `sim`/`rtest` and its users:
 //! the identification ([`crate::ident`]), EIJ maps over the workspace ([`crate::map`]) and
 //! compensation tables.
 //!
@@ -26,7 +27,7 @@
 //! ```
 
 use crate::axes::{Direction, Eij, Plane};
-use crate::control::{ClosedLoop, ControlError};
+use crate::control::{ClosedLoop, ControlError, FrequencyForm};
 use crate::machine::Machine;
 use crate::mbs::MbsError;
 use crate::rtest::{self, EvalOptions, RtestError};
@@ -307,8 +308,7 @@ impl Prediction {
         solver: SolverKind,
     ) -> Result<Vec<Vec<EijMap>>, PredictError> {
         let np = self.poses.len();
-        let loops: Vec<Result<(ClosedLoop, Option<Discrete>), PredictError>> = (0..machines.len()
-            * np)
+        let loops: Vec<Result<(ClosedLoop, Prepared), PredictError>> = (0..machines.len() * np)
             .into_par_iter()
             .map(|k| {
                 let cl = ClosedLoop::new(&machines[k / np], &self.poses[k % np]).map_err(|e| {
@@ -318,20 +318,23 @@ impl Prediction {
                         source: e.into(),
                     }
                 })?;
-                let disc = (solver == SolverKind::Time)
-                    .then(|| Discrete::new(&cl, 1.0 / self.settings.rate_hz));
-                Ok((cl, disc))
+                let prepared = match solver {
+                    SolverKind::Time => {
+                        Prepared::Time(Discrete::new(&cl, 1.0 / self.settings.rate_hz))
+                    }
+                    SolverKind::Harmonic => Prepared::Harmonic(cl.frequency_form()),
+                };
+                Ok((cl, prepared))
             })
             .collect();
-        let loops: Vec<(ClosedLoop, Option<Discrete>)> =
-            loops.into_iter().collect::<Result<_, _>>()?;
+        let loops: Vec<(ClosedLoop, Prepared)> = loops.into_iter().collect::<Result<_, _>>()?;
         let nt = self.tests.len();
         let flat: Vec<Result<EijMap, PredictError>> = (0..machines.len() * nt)
             .into_par_iter()
             .map(|k| {
                 let (s, t) = (k / nt, k % nt);
-                let (cl, disc) = &loops[s * np + self.test_pose[t]];
-                run_test(cl, disc.as_ref(), &self.tests[t], &self.settings).map_err(|source| {
+                let (cl, prepared) = &loops[s * np + self.test_pose[t]];
+                run_test(cl, prepared, &self.tests[t], &self.settings).map_err(|source| {
                     PredictError::Simulation {
                         test: self.tests[t].label(),
                         machine: s,
@@ -364,36 +367,58 @@ pub fn simulated_eij(
     Ok(out)
 }
 
-/// Simulates and evaluates one test on a prepared closed loop (`disc` for the time domain).
+/// A closed loop prepared for one solver: discretised for the time domain, reduced to
+/// Hessenberg form for the harmonic steady state (once for all tests at its circle centre).
+enum Prepared {
+    Time(Discrete),
+    Harmonic(FrequencyForm),
+}
+
+/// Simulates and evaluates one test on a prepared closed loop: the time domain sampled and
+/// evaluated like a measurement, the harmonic steady state by the closed form of that
+/// evaluation ([`rtest::harmonic`]) on the window the sampled route would keep.
 fn run_test(
     cl: &ClosedLoop,
-    disc: Option<&Discrete>,
+    prepared: &Prepared,
     test: &CircleTest,
     settings: &SimSettings,
 ) -> Result<EijMap, SimulationFailure> {
     let radius_m = test.radius_mm * 1e-3;
-    let run = match disc {
-        Some(disc) => {
+    match prepared {
+        Prepared::Time(disc) => {
             let mut circle = Circle::new(test.plane, radius_m, test.accel_m_s2, test.direction);
             circle.steady_revolutions = settings.revolutions;
-            simulate_discrete(cl, disc, &circle)?
+            let run = simulate_discrete(cl, disc, &circle)?;
+            let series = output::to_series(cl, &run, test.label())?;
+            let opts = EvalOptions {
+                plane: Some(test.plane),
+                radius_mm: Some(test.radius_mm),
+            };
+            let (_, joint) = rtest::evaluate_joint(&series, &opts)?;
+            Ok(joint.eij)
         }
-        None => {
-            let ph =
-                harmonic::circle_phasors(cl, test.plane, radius_m, test.accel_m_s2, test.direction)
-                    .ok_or(SimulationFailure::Resonance)?;
-            harmonic::steady_circle(
-                &ph,
+        Prepared::Harmonic(form) => {
+            let ph = harmonic::circle_phasors_in(
+                form,
+                &cl.axes,
+                test.plane,
+                radius_m,
+                test.accel_m_s2,
+                test.direction,
+            )
+            .ok_or(SimulationFailure::Resonance)?;
+            let steady = harmonic::steady_harmonic(cl, test.plane, &ph);
+            let window = harmonic::steady_window(
+                ph.omega,
                 settings.harmonic_samples_per_revolution,
                 settings.revolutions as usize,
-            )
+            );
+            Ok(rtest::harmonic::joint_eij(
+                &steady,
+                test.radius_mm,
+                &window,
+                &test.label(),
+            )?)
         }
-    };
-    let series = output::to_series(cl, &run, test.label())?;
-    let opts = EvalOptions {
-        plane: Some(test.plane),
-        radius_mm: Some(test.radius_mm),
-    };
-    let (_, joint) = rtest::evaluate_joint(&series, &opts)?;
-    Ok(joint.eij)
+    }
 }

@@ -54,7 +54,7 @@ pub struct IdentifyArgs {
     #[arg(long)]
     no_design: bool,
     /// Identification settings (TOML: parameters, solver, method, max_iters, tol_cost,
-    /// tol_step, min_factor, max_factor, rate_hz, revolutions, radius_mm, position_mm,
+    /// tol_step, tol_noise, min_factor, max_factor, rate_hz, revolutions, radius_mm, position_mm,
     /// table_std_err_um_s2_per_m, static_terms, design).
     #[arg(long, value_name = "FILE.toml")]
     config: Option<PathBuf>,

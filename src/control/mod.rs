@@ -22,6 +22,9 @@ use crate::machine::Machine;
 use crate::mbs::{modal, MbsError, Model};
 use nalgebra::{Complex, DMatrix, DVector};
 
+pub mod frequency;
+pub use frequency::FrequencyForm;
+
 /// Errors building the closed loop.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ControlError {
@@ -264,6 +267,11 @@ impl ClosedLoop {
                 .iter()
                 .map(|&i| format!("{}.torque", machine.axes()[i].axis)),
         );
+        states.extend(
+            filtered
+                .iter()
+                .map(|&i| format!("{}.setpoint_filter", machine.axes()[i].axis)),
+        );
         let mut inputs = Vec::with_capacity(nu);
         for a in machine.axes() {
             inputs.push(format!("{}_pos_set_m", a.axis));
@@ -375,48 +383,20 @@ impl ClosedLoop {
         )
     }
 
-    /// [`ClosedLoop::response`] for several input vectors with one LU of jωI − A (faer's
-    /// partial-pivoting LU: the one implementation of H(jω), used by the harmonic simulation).
+    /// [`ClosedLoop::response`] for several input vectors with one reduction of A
+    /// ([`FrequencyForm`]: the one implementation of H(jω), used by the harmonic simulation).
     fn responses(
         &self,
         omega: f64,
         inputs: &[Vec<Complex<f64>>],
     ) -> Option<Vec<Vec<Complex<f64>>>> {
-        use faer::linalg::solvers::Solve;
-        let n = self.a.nrows();
-        let (nu, ny) = (self.b.ncols(), self.c.nrows());
-        let zero = Complex::new(0.0, 0.0);
-        let m = faer::Mat::<Complex<f64>>::from_fn(n, n, |i, k| {
-            let d = if i == k {
-                Complex::new(0.0, omega)
-            } else {
-                zero
-            };
-            d - Complex::new(self.a[(i, k)], 0.0)
-        });
-        let rhs = faer::Mat::<Complex<f64>>::from_fn(n, inputs.len(), |i, c| {
-            (0..nu).map(|k| inputs[c][k] * self.b[(i, k)]).sum()
-        });
-        let x = m.partial_piv_lu().solve(&rhs);
-        let finite = |z: Complex<f64>| z.re.is_finite() && z.im.is_finite();
-        if (0..inputs.len()).any(|c| (0..n).any(|i| !finite(x[(i, c)]))) {
-            return None;
-        }
-        Some(
-            inputs
-                .iter()
-                .enumerate()
-                .map(|(c, u)| {
-                    (0..ny)
-                        .map(|o| {
-                            let cx: Complex<f64> = (0..n).map(|i| x[(i, c)] * self.c[(o, i)]).sum();
-                            let du: Complex<f64> = (0..nu).map(|k| u[k] * self.d[(o, k)]).sum();
-                            cx + du
-                        })
-                        .collect()
-                })
-                .collect(),
-        )
+        let form = self.frequency_form();
+        inputs.iter().map(|u| form.response(omega, u)).collect()
+    }
+
+    /// The closed loop reduced for frequency responses at many frequencies.
+    pub fn frequency_form(&self) -> FrequencyForm {
+        FrequencyForm::new(self)
     }
 
     /// The state of rest in equilibrium at constant set input `u` (zero velocity and

@@ -23,6 +23,8 @@ pub struct IdentConfig {
     pub tol_cost: Option<f64>,
     /// Step in θ = 1/p that counts as converged.
     pub tol_step: Option<f64>,
+    /// Gauss–Newton step left, in standard errors, that counts as converged.
+    pub tol_noise: Option<f64>,
     /// Lower bound of every factor.
     pub min_factor: Option<f64>,
     /// Upper bound of every factor.
@@ -94,6 +96,7 @@ impl IdentConfig {
             ("min_factor", self.min_factor, &mut s.min_factor),
             ("tol_cost", self.tol_cost, &mut s.tol_cost),
             ("tol_step", self.tol_step, &mut s.tol_step),
+            ("tol_noise", self.tol_noise, &mut s.tol_noise),
             ("max_factor", self.max_factor, &mut s.max_factor),
             ("rate_hz", self.rate_hz, &mut s.simulation.rate_hz),
             ("radius_mm", self.radius_mm, &mut m.radius_mm),

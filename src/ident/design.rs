@@ -162,7 +162,8 @@ pub fn rank(
     let n = theta.len();
     let statics = problem.statics();
     let pj = statics.project_matrix(e_jac);
-    let rel_std_err_now = rel_std_err(&(pj.transpose() * &pj), theta, s);
+    let f_now = pj.transpose() * &pj;
+    let rel_std_err_now = rel_std_err(&f_now, theta, s);
     let mut notes = Vec::new();
     let candidates = grid(problem);
     let mut sim = problem.settings().simulation.clone();
@@ -242,25 +243,41 @@ pub fn rank(
             circle.accel_m_s2,
             circle.direction,
         ));
-        let mut aug = Statics::new(&existing, &all_rows, mode, &reversal);
+        let mut aug = Statics::assemble(&existing, &all_rows, mode, &reversal);
         if mode != super::StaticTerms::None {
             let mut clocks = problem.clock_of();
             clocks.push("candidate".into());
             let mut planes: Vec<Plane> = problem.tests().iter().map(|t| t.circle.plane).collect();
             planes.push(circle.plane);
-            aug = aug.with_clocks(&clocks, &all_rows, &planes);
+            aug = aug.add_clocks(&clocks, &all_rows, &planes);
         }
         existing.pop();
-        let j = DMatrix::from_fn(m + eijs.len(), n, |r, i| {
-            if r < m {
-                return e_jac[(r, i)];
-            }
-            let e = eijs[r - m];
+        let jc = DMatrix::from_fn(eijs.len(), n, |r, i| {
+            let e = eijs[r];
             let (base, plus) = (sims[0][c][&e], sims[1 + i][c][&e]);
             (plus - base) / h[i] / sigma
         });
-        let pj = aug.project_matrix(&j);
-        let rel = rel_std_err(&(pj.transpose() * &pj), theta, s);
+        // A candidate that brings no static term (most: a new circle centre, one acceleration)
+        // leaves A as it is with zero rows added, so the projection is P for the tests given
+        // and the identity for its rows: its information adds to F without a new SVD.
+        let a = aug.matrix();
+        let unchanged = a.ncols() == statics.matrix().ncols()
+            && a.rows(0, m) == *statics.matrix()
+            && a.rows(m, eijs.len()).iter().all(|v| *v == 0.0);
+        let f = if unchanged {
+            &f_now + jc.transpose() * &jc
+        } else {
+            let j = DMatrix::from_fn(m + eijs.len(), n, |r, i| {
+                if r < m {
+                    e_jac[(r, i)]
+                } else {
+                    jc[(r - m, i)]
+                }
+            });
+            let pj = aug.decomposed().project_matrix(&j);
+            pj.transpose() * &pj
+        };
+        let rel = rel_std_err(&f, theta, s);
         let (w, name) = worst(&rel, &names);
         ranked.push(Candidate {
             circle: circle.clone(),

@@ -5,7 +5,11 @@
 //! by an active bound, clamps θ + δ into the bounds and accepts the step if the cost ½‖r‖²
 //! decreases (then λ ← λ/3), else retries with λ ← 4λ.
 //! It converges when no step decreases the cost any more, when the relative decrease falls
-//! below `tol_cost`, or when the step falls below `tol_step`.
+//! below `tol_cost`, when the step falls below `tol_step`, or — checked before a trial step
+//! is simulated — when the undamped Gauss–Newton step left is shorter than `tol_noise`
+//! standard errors: δᵀJᵀJδ = gᵀ(JᵀJ)⁻¹g ≤ tol_noise²·s² (residuals weighted by σ, s² their
+//! variance per degree of freedom, at least 1), so that neither the cost nor the parameters
+//! would move by anything the noise lets one see.
 
 use argmin::core::{
     Error, IterState, Jacobian, Operator, Problem, Solver, State, TerminationReason,
@@ -24,11 +28,13 @@ pub struct LevenbergMarquardt {
     upper: DVector<f64>,
     tol_cost: f64,
     tol_step: f64,
+    tol_noise: f64,
     converged: bool,
 }
 
 impl LevenbergMarquardt {
-    /// A solver with bounds `lower ≤ θ ≤ upper`, relative cost tolerance and step tolerance.
+    /// A solver with bounds `lower ≤ θ ≤ upper`, relative cost tolerance and step tolerance;
+    /// no noise tolerance (see [`LevenbergMarquardt::with_noise_tolerance`]).
     pub fn new(lower: DVector<f64>, upper: DVector<f64>, tol_cost: f64, tol_step: f64) -> Self {
         LevenbergMarquardt {
             lambda: 1e-3,
@@ -36,8 +42,16 @@ impl LevenbergMarquardt {
             upper,
             tol_cost,
             tol_step,
+            tol_noise: 0.0,
             converged: false,
         }
+    }
+
+    /// Also converged when the Gauss–Newton step left is below `standard_errors` standard
+    /// errors (see the module docs).
+    pub fn with_noise_tolerance(mut self, standard_errors: f64) -> Self {
+        self.tol_noise = standard_errors;
+        self
     }
 
     fn clamp(&self, theta: &DVector<f64>) -> DVector<f64> {
@@ -107,6 +121,18 @@ where
         let nf = free.len();
         let a_free = DMatrix::from_fn(nf, nf, |p, q| a[(free[p], free[q])]);
         let g_free = DVector::from_fn(nf, |p, _| g[free[p]]);
+        if self.tol_noise > 0.0 {
+            let dof = r.len().saturating_sub(nf).max(1) as f64;
+            let s2 = (2.0 * cost / dof).max(1.0);
+            let gauss_newton = a_free
+                .clone()
+                .cholesky()
+                .map(|c| g_free.dot(&c.solve(&g_free)));
+            if gauss_newton.is_some_and(|d| d <= self.tol_noise * self.tol_noise * s2) {
+                self.converged = true;
+                return Ok((state.param(theta).residuals(r).cost(cost).jacobian(j), None));
+            }
+        }
         for _ in 0..16 {
             let mut damped = a_free.clone();
             for i in 0..nf {

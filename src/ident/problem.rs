@@ -5,6 +5,7 @@
 //! loop cannot be simulated has infinite cost, so that the optimiser rejects the step).
 
 use super::parameters::{to_factor, to_theta, Parameter};
+use super::settings::SIMULATION_RESOLUTION;
 use super::statics::{Row, Statics};
 use super::{IdentError, Settings};
 use crate::axes::Eij;
@@ -14,6 +15,7 @@ use argmin::core::{CostFunction, Jacobian, Operator};
 use nalgebra::{DMatrix, DVector};
 use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
 
 /// One measured circle test: its conditions and measured EIJ with their uncertainty.
 #[derive(Debug, Clone, PartialEq)]
@@ -51,6 +53,9 @@ pub struct Problem {
     statics: Statics,
     /// Parameter sets simulated so far.
     evaluations: AtomicU64,
+    /// The latest simulations by parameter set, shared with clones (they simulate the same
+    /// tests; only the static terms may differ, which the simulations do not depend on).
+    cache: Arc<Mutex<SimCache>>,
     /// Trial points that could not be simulated (rejected steps).
     unsimulable: AtomicU64,
 }
@@ -66,6 +71,7 @@ impl Clone for Problem {
             rows: self.rows.clone(),
             statics: self.statics.clone(),
             evaluations: AtomicU64::new(self.evaluations()),
+            cache: Arc::clone(&self.cache),
             unsimulable: AtomicU64::new(self.unsimulable()),
         }
     }
@@ -157,6 +163,7 @@ impl Problem {
             rows,
             statics: Statics::new(&[], &[], super::StaticTerms::None, &[]),
             evaluations: AtomicU64::new(0),
+            cache: Arc::default(),
             unsimulable: AtomicU64::new(0),
         };
         problem.statics = problem.statics_with(&[]);
@@ -306,8 +313,40 @@ impl Problem {
         }
     }
 
-    /// As [`Problem::simulate_many`] with an explicit solver.
+    /// As [`Problem::simulate_many`] with an explicit solver. Parameter sets simulated
+    /// recently (the centre and neighbours of a Jacobian, an accepted step) are taken from a
+    /// cache and not simulated again; [`Problem::evaluations`] counts the ones simulated.
     pub fn simulate_many_with(
+        &self,
+        thetas: &[DVector<f64>],
+        solver: SolverKind,
+    ) -> Result<Vec<Vec<EijMap>>, IdentError> {
+        let cached: Vec<Option<Arc<Vec<EijMap>>>> = {
+            let cache = self.cache.lock().map_err(|_| poisoned())?;
+            thetas.iter().map(|t| cache.get(t, solver)).collect()
+        };
+        let missing: Vec<usize> = (0..thetas.len()).filter(|&k| cached[k].is_none()).collect();
+        let fresh = if missing.is_empty() {
+            Vec::new()
+        } else {
+            let todo: Vec<DVector<f64>> = missing.iter().map(|&k| thetas[k].clone()).collect();
+            self.simulate_uncached(&todo, solver)?
+        };
+        let mut cache = self.cache.lock().map_err(|_| poisoned())?;
+        let mut out: Vec<Option<Vec<EijMap>>> = cached
+            .into_iter()
+            .map(|hit| hit.map(|sims| sims.as_ref().clone()))
+            .collect();
+        for (&k, sims) in missing.iter().zip(fresh) {
+            cache.put(&thetas[k], solver, Arc::new(sims.clone()));
+            out[k] = Some(sims);
+        }
+        out.into_iter()
+            .collect::<Option<Vec<_>>>()
+            .ok_or_else(poisoned)
+    }
+
+    fn simulate_uncached(
         &self,
         thetas: &[DVector<f64>],
         solver: SolverKind,
@@ -343,6 +382,26 @@ impl Problem {
                 let value = self.tests[row.test].measured[&row.eij].0;
                 let sim = sims[row.test].get(&row.eij).copied().unwrap_or(f64::NAN);
                 (sim - value) / row.sigma
+            }),
+        )
+    }
+
+    /// (E_a − E_b)/σ in the order of [`Problem::rows`], a difference within the simulation's
+    /// rounding ([`SIMULATION_RESOLUTION`] of the test's largest EIJ) taken as none: a
+    /// parameter that no test sees then has an exactly zero Jacobian column.
+    fn weighted_difference(&self, a: &[EijMap], b: &[EijMap]) -> DVector<f64> {
+        let largest = |s: &[EijMap], t: usize| s[t].values().fold(0.0_f64, |m, v| m.max(v.abs()));
+        DVector::from_iterator(
+            self.rows.len(),
+            self.rows.iter().map(|row| {
+                let get = |s: &[EijMap]| s[row.test].get(&row.eij).copied().unwrap_or(f64::NAN);
+                let (x, y) = (get(a), get(b));
+                let scale = largest(a, row.test).max(largest(b, row.test));
+                if (x - y).abs() <= SIMULATION_RESOLUTION * scale {
+                    0.0
+                } else {
+                    (x - y) / row.sigma
+                }
             }),
         )
     }
@@ -399,7 +458,8 @@ impl Problem {
             }
         }
         let sims = self.simulate_each(&thetas);
-        let r0 = self.errors_of(&sims[0].clone()?);
+        let centre = sims[0].clone()?;
+        let r0 = self.errors_of(&centre);
         let mut j = DMatrix::zeros(r0.len(), theta.len());
         let mut edges = Vec::new();
         for i in 0..theta.len() {
@@ -409,11 +469,9 @@ impl Problem {
             // Central difference; one-sided where the other side cannot be simulated (a
             // neighbour beyond the closed loop's stability limit).
             let column = match (&sims[1 + 2 * i], &sims[2 + 2 * i]) {
-                (Ok(plus), Ok(minus)) => {
-                    (self.errors_of(plus) - self.errors_of(minus)) / (2.0 * h[i])
-                }
-                (Ok(plus), Err(_)) => (self.errors_of(plus) - &r0) / h[i],
-                (Err(_), Ok(minus)) => (&r0 - self.errors_of(minus)) / h[i],
+                (Ok(plus), Ok(minus)) => self.weighted_difference(plus, minus) / (2.0 * h[i]),
+                (Ok(plus), Err(_)) => self.weighted_difference(plus, &centre) / h[i],
+                (Err(_), Ok(minus)) => self.weighted_difference(&centre, minus) / h[i],
                 (Err(e), Err(_)) => return Err(e.clone()),
             };
             j.set_column(i, &column);
@@ -493,4 +551,39 @@ impl Problem {
             other => other,
         }
     }
+}
+
+/// Simulations kept: a central-difference Jacobian's 2n + 1 parameter sets and a few more.
+const CACHE_SETS: usize = 64;
+
+/// The latest simulated parameter sets (exact θ, solver) and their EIJ, oldest first.
+#[derive(Debug, Default)]
+struct SimCache {
+    entries: std::collections::VecDeque<(Vec<u64>, SolverKind, Arc<Vec<EijMap>>)>,
+}
+
+impl SimCache {
+    fn key(theta: &DVector<f64>) -> Vec<u64> {
+        theta.iter().map(|t| t.to_bits()).collect()
+    }
+
+    fn get(&self, theta: &DVector<f64>, solver: SolverKind) -> Option<Arc<Vec<EijMap>>> {
+        let key = Self::key(theta);
+        self.entries
+            .iter()
+            .find(|(k, s, _)| *k == key && *s == solver)
+            .map(|(_, _, sims)| Arc::clone(sims))
+    }
+
+    fn put(&mut self, theta: &DVector<f64>, solver: SolverKind, sims: Arc<Vec<EijMap>>) {
+        if self.entries.len() == CACHE_SETS {
+            self.entries.pop_front();
+        }
+        self.entries.push_back((Self::key(theta), solver, sims));
+    }
+}
+
+/// The cache unusable (a thread panicked holding its lock) or a simulation result missing.
+fn poisoned() -> IdentError {
+    IdentError::Optimiser("simulation results lost (a simulation thread panicked)".into())
 }

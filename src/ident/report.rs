@@ -205,6 +205,9 @@ pub struct SettingsReport {
     pub tol_cost: f64,
     /// Step in θ = 1/p that counts as converged.
     pub tol_step: f64,
+    /// Gauss–Newton step left, in standard errors, that counts as converged.
+    #[serde(default)]
+    pub tol_noise: Option<f64>,
     /// Central-difference step, relative to θ.
     pub fd_step: f64,
     /// Smallest σ used to weight a measured value, µm·s²/m.
@@ -226,6 +229,7 @@ impl From<&Settings> for SettingsReport {
             max_iters: s.max_iters(),
             tol_cost: s.tol_cost,
             tol_step: s.tol_step,
+            tol_noise: Some(s.tol_noise),
             fd_step: s.fd_step,
             sigma_floor_um_s2_per_m: s.sigma_floor,
             static_terms: Some(s.static_terms),

@@ -43,6 +43,10 @@ pub struct Settings {
     pub tol_cost: f64,
     /// Step in θ = 1/p that counts as converged (1e-8).
     pub tol_step: f64,
+    /// Converged when the Gauss–Newton step left is shorter than this many standard errors
+    /// (0.01; Levenberg–Marquardt only, see [`super::lm`]): further iterations would move
+    /// neither the parameters nor χ² (by 1e-4 s²) by anything the noise lets one see.
+    pub tol_noise: f64,
     /// Central-difference step, relative to θ (1e-3).
     pub fd_step: f64,
     /// Optimiser (Levenberg–Marquardt).
@@ -64,6 +68,7 @@ impl Default for Settings {
             max_iters: None,
             tol_cost: 1e-10,
             tol_step: 1e-8,
+            tol_noise: 0.01,
             fd_step: 1e-3,
             method: Method::Lm,
             sigma_floor: 1e-3,
@@ -114,6 +119,12 @@ impl Default for MeasuredOptions {
         }
     }
 }
+
+/// Simulated EIJ that differ by less than this fraction of the test's largest EIJ differ by
+/// rounding only (the harmonic simulation resolves ~1e-13 relative; a reduction factor that a test
+/// sees moves its EIJ by far more over a finite-difference step): their difference counts as
+/// zero in the Jacobian.
+pub const SIMULATION_RESOLUTION: f64 = 1e-10;
 
 /// A parameter whose Jacobian column norm at the start is below this fraction of the largest
 /// is not seen by the tests: it is kept at its start value and reported not identifiable.

@@ -75,7 +75,8 @@ pub(super) fn optimise(
                 DVector::from_element(nf, hi),
                 s.tol_cost,
                 s.tol_step,
-            );
+            )
+            .with_noise_tolerance(s.tol_noise);
             let observer = Progress {
                 costs,
                 callback: progress,

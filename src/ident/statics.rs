@@ -165,6 +165,17 @@ impl Statics {
         mode: StaticTerms,
         reversal: &[usize],
     ) -> Statics {
+        Self::assemble(tests, rows, mode, reversal).decomposed()
+    }
+
+    /// As [`Statics::new`] without the decomposition of A (projections are the identity until
+    /// [`Statics::decomposed`]): for comparing A before paying for its SVD.
+    pub(crate) fn assemble(
+        tests: &[(Plane, Vec<f64>, f64, Direction)],
+        rows: &[Row],
+        mode: StaticTerms,
+        reversal: &[usize],
+    ) -> Statics {
         let mut groups: Vec<StaticGroup> = Vec::new();
         for (i, (plane, pos, _, _)) in tests.iter().enumerate() {
             match groups
@@ -249,15 +260,22 @@ impl Statics {
             };
             -sign * row.r_over_a / row.sigma
         });
-        let (basis, pinv) = decompose(&a);
         Statics {
             groups,
             columns,
             clocks: Vec::new(),
+            basis: DMatrix::zeros(a.nrows(), 0),
+            pinv: DMatrix::zeros(a.ncols(), a.nrows()),
             a,
-            basis,
-            pinv,
         }
+    }
+
+    /// The projection onto the complement of A's columns computed (SVD of A).
+    pub(crate) fn decomposed(mut self) -> Statics {
+        let (basis, pinv) = decompose(&self.a);
+        self.basis = basis;
+        self.pinv = pinv;
+        self
     }
 
     /// Adds a clock-offset term per clock whose tests hold both directions (`clock_of[test]`
@@ -268,7 +286,17 @@ impl Statics {
     /// 1 %.
     /// A velocity-proportional structural deviation (damping) has the same shape, but the model
     /// predicts it, so only a true offset is left for δ.
-    pub fn with_clocks(mut self, clock_of: &[String], rows: &[Row], planes: &[Plane]) -> Statics {
+    pub fn with_clocks(self, clock_of: &[String], rows: &[Row], planes: &[Plane]) -> Statics {
+        self.add_clocks(clock_of, rows, planes).decomposed()
+    }
+
+    /// As [`Statics::with_clocks`] without the decomposition (see [`Statics::assemble`]).
+    pub(crate) fn add_clocks(
+        mut self,
+        clock_of: &[String],
+        rows: &[Row],
+        planes: &[Plane],
+    ) -> Statics {
         let mut names: Vec<String> = clock_of.to_vec();
         names.sort();
         names.dedup();
@@ -318,9 +346,6 @@ impl Statics {
             let last = self.a.ncols() - 1;
             self.a.set_column(last, &col);
         }
-        let (basis, pinv) = decompose(&self.a);
-        self.basis = basis;
-        self.pinv = pinv;
         self
     }
 

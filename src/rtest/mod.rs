@@ -41,6 +41,7 @@ pub mod clock_fit;
 pub mod conditions;
 pub mod error;
 pub mod fit;
+pub mod harmonic;
 pub mod inputs;
 pub mod iso230;
 pub mod json;

@@ -1,16 +1,18 @@
 //! Harmonic steady state: a circle's set points are sinusoids at one frequency, so in steady
 //! state every output is y(t) = Re(Y e^{jωt}) with Y = H(jω) U, H(jω) = C (jωI − A)⁻¹ B + D —
-//! one complex solve instead of a time integration ([`ClosedLoop::response`], faer's
-//! partial-pivoting LU).
+//! one complex solve instead of a time integration, on the closed loop's Hessenberg form
+//! ([`FrequencyForm`], shared by all tests of one closed loop).
 //!
 //! For the circle a = r·cos ωt, b = r·sin ωt (paper eq. 3–4, ω < 0 for cw) the input phasors
 //! are U_a = (r, jωr, −ω²r) and U_b = (−jr, ωr, jω²r) for (position, velocity, acceleration).
-//! [`steady_circle`] samples the steady state over whole revolutions as a [`Run`], so the same
-//! output and evaluation code serves harmonic and time-domain results alike.
+//! [`steady_harmonic`] hands the phasors to the closed-form evaluation
+//! ([`crate::rtest::harmonic`]); [`steady_circle`] samples the steady state over whole
+//! revolutions as a [`Run`] for the sampled evaluation, which the closed form reproduces.
 
 use super::Run;
-use crate::axes::{Direction, Plane};
-use crate::control::ClosedLoop;
+use crate::axes::{Axis, Direction, Plane};
+use crate::control::{ClosedLoop, FrequencyForm, INPUTS_PER_AXIS};
+use crate::rtest::harmonic::{SteadyHarmonic, Window};
 use faer::c64;
 
 /// The steady-state complex amplitudes of the closed loop's inputs and outputs for a circle.
@@ -33,12 +35,24 @@ pub fn circle_phasors(
     accel_m_s2: f64,
     direction: Direction,
 ) -> Option<CirclePhasors> {
+    let form = cl.frequency_form();
+    circle_phasors_in(&form, &cl.axes, plane, radius_m, accel_m_s2, direction)
+}
+
+/// As [`circle_phasors`] on a closed loop reduced beforehand (`axes`: its axes in input order).
+pub fn circle_phasors_in(
+    form: &FrequencyForm,
+    axes: &[Axis],
+    plane: Plane,
+    radius_m: f64,
+    accel_m_s2: f64,
+    direction: Direction,
+) -> Option<CirclePhasors> {
     let omega = direction.sign() * (accel_m_s2 / radius_m).sqrt();
     let (a, b) = plane.axes();
-    let nu = cl.b.ncols();
-    let mut u = vec![c64::new(0.0, 0.0); nu];
+    let mut u = vec![c64::new(0.0, 0.0); INPUTS_PER_AXIS * axes.len()];
     let r = radius_m;
-    for (i, ax) in cl.axes.iter().enumerate() {
+    for (i, ax) in axes.iter().enumerate() {
         let v = if *ax == a {
             [
                 c64::new(r, 0.0),
@@ -54,9 +68,9 @@ pub fn circle_phasors(
         } else {
             continue;
         };
-        u[3 * i..3 * i + 3].copy_from_slice(&v);
+        u[INPUTS_PER_AXIS * i..INPUTS_PER_AXIS * (i + 1)].copy_from_slice(&v);
     }
-    let outputs = cl.response(omega, &u)?;
+    let outputs = form.response(omega, &u)?;
     Some(CirclePhasors {
         omega,
         inputs: u,
@@ -64,14 +78,60 @@ pub fn circle_phasors(
     })
 }
 
+/// The R-Test view of the phasors: internal readings along the plane's axes (mm) and the
+/// structural deviation external − internal along a, b and the normal (µm), as the CSV
+/// columns and [`super::output::to_series`] give them (0 for an axis the machine lacks).
+pub fn steady_harmonic(cl: &ClosedLoop, plane: Plane, phasors: &CirclePhasors) -> SteadyHarmonic {
+    let output = |name: String| -> c64 {
+        cl.output(&name)
+            .map_or(c64::new(0.0, 0.0), |i| phasors.outputs[i])
+    };
+    let (a, b) = plane.axes();
+    let int_m = |ax: Axis| output(format!("{ax}_int_m"));
+    let dev_um = |ax: Axis| (output(format!("{ax}_tcp_m")) - int_m(ax)) * 1e6;
+    SteadyHarmonic {
+        plane,
+        omega_rad_s: phasors.omega,
+        int_mm: [int_m(a) * 1e3, int_m(b) * 1e3],
+        dev_um: [dev_um(a), dev_um(b), dev_um(plane.normal())],
+    }
+}
+
+/// Revolutions sampled beyond the ones evaluated: a quarter at each end where the evaluation's
+/// half-revolution speed is undefined, and a quarter of slack for its sampling stride.
+pub const STEADY_MARGIN: f64 = 0.75;
+
+/// Samples of [`steady_circle`]: whole revolutions, the margin, and the closing sample.
+fn steady_samples(samples_per_revolution: usize, revolutions: usize) -> usize {
+    revolutions * samples_per_revolution
+        + (STEADY_MARGIN * samples_per_revolution as f64).round() as usize
+        + 1
+}
+
+/// The window the evaluation keeps of [`steady_circle`]'s samples: `revolutions` whole
+/// revolutions centred in the record (the sampled evaluation's window starts within a few
+/// samples of it, by its speed search's stride).
+pub fn steady_window(omega: f64, samples_per_revolution: usize, revolutions: usize) -> Window {
+    let spare = steady_samples(samples_per_revolution, revolutions)
+        - 1
+        - revolutions * samples_per_revolution;
+    Window {
+        start_rad: omega.signum() * std::f64::consts::TAU * 0.5 * spare as f64
+            / samples_per_revolution as f64,
+        samples_per_revolution,
+        revolutions,
+    }
+}
+
 /// e^{jθ}: the phasors rotated to set-point angle θ give the outputs there, y = Re(Y e^{jθ}).
 pub fn phase_factor(theta: f64) -> c64 {
     c64::cis(theta)
 }
 
-/// Samples the steady state of `phasors` over `revolutions` whole revolutions plus half a
-/// revolution (the evaluation trims a quarter revolution at each end while it looks for the
-/// steady part), `samples_per_revolution` samples per revolution.
+/// Samples the steady state of `phasors` over `revolutions` whole revolutions plus
+/// [`STEADY_MARGIN`] of a revolution (the evaluation cannot tell the speed within a quarter
+/// revolution of either end and keeps whole revolutions, centred, of the rest),
+/// `samples_per_revolution` samples per revolution: the evaluation keeps `revolutions`.
 pub fn steady_circle(
     phasors: &CirclePhasors,
     samples_per_revolution: usize,
@@ -79,7 +139,7 @@ pub fn steady_circle(
 ) -> Run {
     let period = std::f64::consts::TAU / phasors.omega.abs();
     let h = period / samples_per_revolution as f64;
-    let n = (revolutions * samples_per_revolution) + samples_per_revolution / 2 + 1;
+    let n = steady_samples(samples_per_revolution, revolutions);
     let (nu, ny) = (phasors.inputs.len(), phasors.outputs.len());
     let mut run = Run {
         t_s: Vec::with_capacity(n),
