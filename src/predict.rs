@@ -379,6 +379,18 @@ fn run_test(
             simulate_discrete(cl, disc, &circle)?
         }
         None => {
+            let n = settings.harmonic_samples_per_revolution as f64 * settings.revolutions as f64;
+            if n > crate::sim::MAX_SAMPLES as f64 {
+                return Err(SimulationFailure::Time(crate::sim::SimError::Invalid(
+                    format!(
+                    "{} revolutions of {} samples would be {} samples, at most {} are simulated",
+                    settings.revolutions,
+                    settings.harmonic_samples_per_revolution,
+                    crate::text::num(n),
+                    crate::sim::MAX_SAMPLES
+                ),
+                )));
+            }
             let ph =
                 harmonic::circle_phasors(cl, test.plane, radius_m, test.accel_m_s2, test.direction)
                     .ok_or(SimulationFailure::Resonance)?;
