@@ -280,7 +280,7 @@ impl CompensationTable {
             at,
             message,
         };
-        let text = std::fs::read_to_string(path)
+        let text = crate::io::read_input_text(path, crate::io::read::MAX_TEXT_BYTES)
             .map_err(|e| err("file".into(), format!("cannot read: {e}")))?;
         let mut rdr = csv::ReaderBuilder::new()
             .trim(csv::Trim::All)

@@ -71,6 +71,7 @@ pub mod predict;
 pub mod report;
 pub mod rtest;
 pub mod sim;
+pub mod text;
 
 pub use axes::{Axis, Direction, Eij, Plane};
 pub use control::ClosedLoop;

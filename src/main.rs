@@ -42,7 +42,7 @@ fn main() -> std::process::ExitCode {
     match cli.run() {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {
-            let line = format!("{e:#}").replace('\n', " ");
+            let line = eij::text::compact_numbers(&format!("{e:#}").replace('\n', " "));
             eprintln!("eij: error: {line}");
             std::process::ExitCode::FAILURE
         }

@@ -248,7 +248,12 @@ pub fn read_csv(path: &std::path::Path) -> Result<(MapSpec, Vec<MapPoint>), MapE
         at: format!("{name}:{line}"),
         message: m,
     };
-    let text = std::fs::read_to_string(path).map_err(|e| bad(0, format!("cannot read: {e}")))?;
+    let text = crate::io::read_input_text(path, crate::io::read::MAX_TEXT_BYTES).map_err(|e| {
+        MapError::Table {
+            at: name.clone(),
+            message: format!("cannot read: {e}"),
+        }
+    })?;
     let mut reader = csv::ReaderBuilder::new().from_reader(text.as_bytes());
     let header: Vec<String> = reader
         .headers()

@@ -230,9 +230,8 @@ fn unstable_gains_are_refused_naming_the_axis() {
         Err(e @ ControlError::Unstable { axis: Axis::X, .. }) => {
             let msg = e.to_string();
             assert!(
-                msg.starts_with(
-                    "hot-gains.toml: closed loop unstable with the control gains of axis x"
-                ),
+                msg.starts_with("hot-gains.toml: closed loop unstable at axis x")
+                    && msg.ends_with("lower kv_per_s or kp_nm_s_per_rad, or raise tn_s"),
                 "{msg}"
             );
         }

@@ -33,8 +33,8 @@ pub struct CompensationArgs {
 
 /// Runs `eij compensation`.
 pub fn run(args: CompensationArgs) -> anyhow::Result<()> {
-    eij::io::check_outputs(&[args.out.as_path()], &[args.machine.as_path()])?;
     let machine = Machine::from_file(&args.machine)?;
+    eij::io::check_outputs(&[args.out.as_path()], &[args.machine.as_path()])?;
     let spec = TableSpec {
         radius_mm: args.radius_mm,
         accel_m_s2: args.accel_m_s2,

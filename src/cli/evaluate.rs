@@ -59,7 +59,14 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<()> {
             args.files.len()
         );
     }
-    let inputs: Vec<&Path> = args.files.iter().map(PathBuf::as_path).collect();
+    let tests = expand_tests(&args.files)?;
+    let files: Vec<PathBuf> = tests.iter().flat_map(|t| t.files()).collect();
+    let inputs: Vec<&Path> = args
+        .files
+        .iter()
+        .chain(&files)
+        .map(PathBuf::as_path)
+        .collect();
     let outputs: Vec<&Path> = args
         .csv_out
         .iter()
@@ -67,7 +74,6 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<()> {
         .map(PathBuf::as_path)
         .collect();
     eij::io::check_outputs(&outputs, &inputs)?;
-    let tests = expand_tests(&args.files)?;
     if args.plot.is_some() && tests.len() != 1 {
         anyhow::bail!(
             "--plot: {} tests in {}, a plot shows one test (use `eij report` for several)",
@@ -112,16 +118,23 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<()> {
         }
         _ => None,
     };
-    if let Some(out) = &args.csv_out {
+    let csv = args.csv_out.as_ref().map(|_| {
         let rows: Vec<_> = suite
             .tests
             .iter()
             .flat_map(|t| table::rows_from_result(&t.result))
             .collect();
-        table::write(out, &rows, &inputs)?;
+        table::to_csv(&rows)
+    });
+    let mut files: Vec<(&Path, &[u8])> = Vec::new();
+    if let (Some(out), Some(csv)) = (&args.csv_out, &csv) {
+        files.push((out, csv.as_bytes()));
     }
-    if let (Some(plot), Some(svg)) = (&args.plot, plot_svg) {
-        eij::io::write_atomic(plot, svg.as_bytes(), &inputs)?;
+    if let (Some(plot), Some(svg)) = (&args.plot, &plot_svg) {
+        files.push((plot, svg.as_bytes()));
+    }
+    if !files.is_empty() {
+        eij::io::write_set(&files, &inputs)?;
     }
     for w in suite
         .tests

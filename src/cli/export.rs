@@ -24,8 +24,8 @@ fn rows(m: &DMatrix<f64>) -> Vec<Vec<f64>> {
 
 /// Runs `eij export`.
 pub fn run(args: ExportArgs) -> anyhow::Result<()> {
-    eij::io::check_outputs(&[&args.out], &[&args.machine.machine])?;
     let (machine, pose) = args.machine.load()?;
+    eij::io::check_outputs(&[&args.out], &[&args.machine.machine])?;
     let cl = ClosedLoop::new(&machine, &pose)?;
     let m = &cl.model;
     let out = json!({

@@ -1,6 +1,6 @@
 //! `eij identify` and `eij verify`: fit reduction factors to measured EIJ; re-run known-good fits.
 
-use super::machine_args::write_output;
+use super::machine_args::{write_output, write_outputs};
 use anyhow::{bail, Context};
 use eij::ident::config::{IdentConfig, KnownGood};
 use eij::ident::measured::{self, MeasuredOptions};
@@ -287,6 +287,14 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
         Some(c) => IdentConfig::from_file(c)?,
         None => IdentConfig::default(),
     };
+    // The values given as options are checked as such, before they override the file's.
+    IdentConfig {
+        max_iters: args.max_iters.map(|m| m as f64),
+        radius_mm: args.radius_mm,
+        position_mm: args.position_mm.clone(),
+        ..IdentConfig::default()
+    }
+    .apply(&mut Settings::default(), &mut MeasuredOptions::default())?;
     if let Some(m) = args.method {
         config.method = Some(m.into());
     }
@@ -294,7 +302,7 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
         config.solver = Some(m.into());
     }
     if let Some(m) = args.max_iters {
-        config.max_iters = Some(m);
+        config.max_iters = Some(m as f64);
     }
     if let Some(r) = args.radius_mm {
         config.radius_mm = Some(r);
@@ -395,15 +403,22 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
         Some(_) => Some(eij::report::identification_svg(&ident_report)?),
         None => None,
     };
-    write_output(&out, toml_text.as_bytes(), &input_refs)?;
-    write_output(&report_path, &ident_report.to_json(), &input_refs)?;
-    if let Some(path) = &args.stiffness_out {
-        let table = eij::ident::stiffness::identified_table(&prep.problem, &result);
-        write_output(path, &table.to_csv(), &input_refs)?;
+    let report_json = ident_report.to_json();
+    let table = args
+        .stiffness_out
+        .as_ref()
+        .map(|_| eij::ident::stiffness::identified_table(&prep.problem, &result).to_csv());
+    let mut files: Vec<(&Path, &[u8])> = vec![
+        (&out, toml_text.as_bytes()),
+        (&report_path, report_json.as_slice()),
+    ];
+    if let (Some(path), Some(table)) = (&args.stiffness_out, &table) {
+        files.push((path, table.as_slice()));
     }
     if let (Some(path), Some(svg)) = (&args.plot, &svg) {
-        write_output(path, svg.as_bytes(), &input_refs)?;
+        files.push((path, svg.as_bytes()));
     }
+    write_outputs(&files, &input_refs)?;
     if !args.quiet {
         let table = args
             .stiffness_out

@@ -58,12 +58,22 @@ impl MachineArgs {
     }
 }
 
-/// Writes `bytes` atomically to `out`, refusing to overwrite any of `inputs`.
+/// Writes `bytes` atomically to `out`, refusing to overwrite any of `inputs` or any file the
+/// run has read.
 pub fn write_output(
     out: &std::path::Path,
     bytes: &[u8],
     inputs: &[&std::path::Path],
 ) -> anyhow::Result<()> {
-    eij::io::write_atomic(out, bytes, inputs)?;
+    write_outputs(&[(out, bytes)], inputs)
+}
+
+/// Writes the outputs of a run as one set ([`eij::io::write_set`]): all or none, never
+/// replacing any of `inputs` or any file the run has read.
+pub fn write_outputs(
+    files: &[(&std::path::Path, &[u8])],
+    inputs: &[&std::path::Path],
+) -> anyhow::Result<()> {
+    eij::io::write_set(files, inputs)?;
     Ok(())
 }

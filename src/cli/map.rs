@@ -1,6 +1,6 @@
 //! `eij map`: EIJ over a grid of axis positions, as a compensation table.
 
-use super::machine_args::write_output;
+use super::machine_args::write_outputs;
 use anyhow::bail;
 use eij::axes::{Direction, Plane};
 use eij::machine::Machine;
@@ -56,8 +56,11 @@ pub fn run(args: MapArgs) -> anyhow::Result<()> {
             args.accel_m_s2
         );
     }
-    eij::io::check_outputs(&[&args.out], &[&args.machine])?;
     let machine = Machine::from_file(&args.machine)?;
+    let outputs: Vec<&std::path::Path> = std::iter::once(args.out.as_path())
+        .chain(args.plot.as_deref())
+        .collect();
+    eij::io::check_outputs(&outputs, &[&args.machine])?;
     let grids = args
         .grids
         .iter()
@@ -81,13 +84,10 @@ pub fn run(args: MapArgs) -> anyhow::Result<()> {
         )?),
         None => None,
     };
-    write_output(
-        &args.out,
-        to_csv(&machine, &spec, &points).as_bytes(),
-        &[&args.machine],
-    )?;
-    if let (Some(path), Some(svg)) = (&args.plot, svg) {
-        write_output(path, svg.as_bytes(), &[&args.machine, &args.out])?;
+    let csv = to_csv(&machine, &spec, &points);
+    let mut files: Vec<(&std::path::Path, &[u8])> = vec![(&args.out, csv.as_bytes())];
+    if let (Some(path), Some(svg)) = (&args.plot, &svg) {
+        files.push((path, svg.as_bytes()));
     }
-    Ok(())
+    write_outputs(&files, &[&args.machine])
 }

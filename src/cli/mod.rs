@@ -54,6 +54,8 @@ enum Command {
 impl Cli {
     /// Runs the chosen subcommand.
     pub fn run(self) -> anyhow::Result<()> {
+        // One run per process: every file it reads is an input no output may replace.
+        eij::io::track_inputs();
         match self.command {
             Command::Evaluate(args) => evaluate::run(args),
             Command::EvaluateMove(args) => evaluate_move::run(args),

@@ -17,9 +17,20 @@ pub struct ModalArgs {
 /// Runs `eij modal`.
 pub fn run(args: ModalArgs) -> anyhow::Result<()> {
     let (machine, pose) = args.machine.load()?;
+    // The same checks as every other command (support, stable closed loop), so that no machine
+    // that `export` or `simulate` refuses gets frequencies here.
+    eij::control::ClosedLoop::new(&machine, &pose)?;
     let model = Model::assemble(&machine, &pose)?;
     modal::check_support(&model, &machine)?;
     let modes = modal::modes(&model)?;
+    if let Some(m) = modes.iter().find(|m| !m.frequency_hz.is_finite()) {
+        anyhow::bail!(
+            "{}: the modal analysis gave a frequency of {} Hz (dominant DOF {}): the model is numerically degenerate",
+            machine.source(),
+            m.frequency_hz,
+            m.dominant_dof
+        );
+    }
     if args.json {
         let out = json!({
             "machine": machine.source(),

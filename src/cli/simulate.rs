@@ -1,6 +1,6 @@
 //! `eij simulate circle|move …`: closed-loop time-domain simulation to an R-Test-like CSV.
 
-use super::machine_args::{write_output, MachineArgs};
+use super::machine_args::{write_outputs, MachineArgs};
 use anyhow::bail;
 use eij::axes::{Axis, Direction, Plane};
 use eij::compensation::{Compensated, CompensationTable};
@@ -187,10 +187,20 @@ fn check_samples(common: &Common, sp: &dyn SetPoint, freq_hz: Option<f64>) -> an
             );
         }
     }
-    let mut outputs = vec![common.out.as_path()];
-    outputs.extend(common.plot.as_deref());
-    eij::io::check_outputs(&outputs, &common.inputs())?;
     Ok(())
+}
+
+impl Common {
+    /// Loads the machine and its pose, the compensation table, then checks the outputs (with
+    /// every file read so far: the machine's catalogues and the table count as inputs).
+    fn load(&self) -> anyhow::Result<(Machine, Vec<f64>, Option<CompensationTable>)> {
+        let (machine, pose) = self.machine.load()?;
+        let table = self.table(&machine)?;
+        let mut outputs = vec![self.out.as_path()];
+        outputs.extend(self.plot.as_deref());
+        eij::io::check_outputs(&outputs, &self.inputs())?;
+        Ok((machine, pose, table))
+    }
 }
 
 fn positive(name: &str, v: f64) -> anyhow::Result<f64> {
@@ -243,7 +253,7 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
 }
 
 fn run_move(common: &Common, mv: &JerkLimitedMove) -> anyhow::Result<()> {
-    let (machine, pose) = common.machine.load()?;
+    let (machine, pose, table) = common.load()?;
     let Some(i) = machine.axes().iter().position(|a| a.axis == mv.axis) else {
         bail!("{}: the machine has no axis {}", machine.source(), mv.axis);
     };
@@ -260,7 +270,6 @@ fn run_move(common: &Common, mv: &JerkLimitedMove) -> anyhow::Result<()> {
     }
     // Re-assembled every 10 mm of travel (eij::sim::move_segments).
     let rate = positive("rate-hz", common.rate_hz)?;
-    let table = common.table(&machine)?;
     let segments = eij::sim::move_segments(&machine, &pose, i, mv, rate)?;
     let cond = conditions(common, &machine, &pose);
     let comp = compensate(mv, table.as_ref(), &pose, &machine);
@@ -280,7 +289,7 @@ fn run_setpoint(
     plane: Plane,
     radius_mm: f64,
 ) -> anyhow::Result<()> {
-    let (machine, pose) = common.machine.load()?;
+    let (machine, pose, table) = common.load()?;
     let (a, b) = plane.axes();
     for ax in [a, b] {
         if machine.axis(ax).is_none() {
@@ -292,7 +301,6 @@ fn run_setpoint(
     }
     let cl = ClosedLoop::new(&machine, &pose)?;
     let cond = conditions(common, &machine, &pose);
-    let table = common.table(&machine)?;
     let comp = compensate(sp, table.as_ref(), &pose, &machine);
     let rate = positive("rate-hz", common.rate_hz)?;
     let run = match &comp {
@@ -357,12 +365,9 @@ fn write_output_files(
             Some((path, move_svg(&data, &cond)?))
         }
     };
-    let inputs = common.inputs();
-    write_output(&common.out, &bytes, &inputs)?;
-    if let Some((path, svg)) = plot {
-        let mut inputs = inputs;
-        inputs.push(&common.out);
-        write_output(path, svg.as_bytes(), &inputs)?;
+    let mut files: Vec<(&std::path::Path, &[u8])> = vec![(&common.out, &bytes)];
+    if let Some((path, svg)) = &plot {
+        files.push((path, svg.as_bytes()));
     }
-    Ok(())
+    write_outputs(&files, &common.inputs())
 }

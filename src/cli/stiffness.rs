@@ -20,10 +20,10 @@ pub struct StiffnessArgs {
 
 /// Runs `eij stiffness`.
 pub fn run(args: StiffnessArgs) -> anyhow::Result<()> {
+    let machine = Machine::from_file(&args.machine)?;
     if let Some(out) = &args.out {
         eij::io::check_outputs(&[out.as_path()], &[args.machine.as_path()])?;
     }
-    let machine = Machine::from_file(&args.machine)?;
     let (table, warnings) = machine_table(&machine);
     for w in &warnings {
         eprintln!("warning: {w}");

@@ -32,7 +32,7 @@ pub enum ControlError {
     #[error(transparent)]
     Mbs(#[from] MbsError),
     /// The closed loop has an eigenvalue with non-negative real part.
-    #[error("{machine}: closed loop unstable with the control gains of axis {axis} (eigenvalue {re:.3} ± {im:.3}i 1/s, {freq_hz:.1} Hz): lower kv_per_s or kp_nm_s_per_rad, or raise tn_s")]
+    #[error("{machine}: closed loop unstable at axis {axis} (eigenvalue {re:.3} ± {im:.3}i 1/s, {freq_hz:.1} Hz): {hint}")]
     Unstable {
         /// Machine source.
         machine: String,
@@ -44,6 +44,9 @@ pub enum ControlError {
         im: f64,
         /// |λ|/(2π).
         freq_hz: f64,
+        /// What to change: the current-loop lag where it is long against the unstable mode,
+        /// else the gains.
+        hint: String,
     },
     /// The eigen-solver failed.
     #[error("{machine}: closed-loop eigenvalues could not be computed")]
@@ -349,12 +352,26 @@ impl ClosedLoop {
             .max_by(|x, y| x.1.total_cmp(&y.1))
             .map_or(self.axes[0], |(i, _)| self.axes[i]);
         let (re, im) = (s[k].re, s[k].im.abs());
+        let omega = (re * re + im * im).sqrt();
+        let lag = machine.axis(axis).map_or(0.0, |a| a.control.current_lag_s);
+        // A first-order lag costs ωτ rad of phase at the mode: beyond ~0.3 rad it, not the
+        // gains, is what the loop cannot take.
+        let hint = if lag * omega > 0.3 {
+            format!(
+                "the current-loop lag current_lag_s = {} s is long for this loop (ωτ = {:.2} at the unstable mode): shorten it, or lower kp_nm_s_per_rad",
+                crate::text::num(lag),
+                lag * omega
+            )
+        } else {
+            "lower kv_per_s or kp_nm_s_per_rad, or raise tn_s".to_string()
+        };
         Err(ControlError::Unstable {
             machine: machine.source().to_string(),
             axis,
             re,
             im,
-            freq_hz: (re * re + im * im).sqrt() / std::f64::consts::TAU,
+            freq_hz: omega / std::f64::consts::TAU,
+            hint,
         })
     }
 

@@ -3,6 +3,7 @@
 
 use super::measured::MeasuredOptions;
 use super::{IdentError, Method, Settings};
+use crate::text::num;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -17,8 +18,9 @@ pub struct IdentConfig {
     pub solver: Option<super::SolverKind>,
     /// `lm` or `nelder-mead`.
     pub method: Option<Method>,
-    /// Iteration limit.
-    pub max_iters: Option<u64>,
+    /// Iteration limit (a whole number; read as a number so that `1e3` is accepted and
+    /// `1e30` refused by its size, not by its notation).
+    pub max_iters: Option<f64>,
     /// Relative decrease of Σr² that counts as converged.
     pub tol_cost: Option<f64>,
     /// Step in θ = 1/p that counts as converged.
@@ -31,8 +33,8 @@ pub struct IdentConfig {
     pub max_factor: Option<f64>,
     /// Output rate of the simulated tests, Hz.
     pub rate_hz: Option<f64>,
-    /// Steady revolutions per simulated test.
-    pub revolutions: Option<u32>,
+    /// Steady revolutions per simulated test (a whole number, like `max_iters`).
+    pub revolutions: Option<f64>,
     /// Set radius of the circle tests, mm (2).
     pub radius_mm: Option<f64>,
     /// Axis positions of the circle centre, mm (for tests whose folder does not say).
@@ -53,23 +55,35 @@ pub struct IdentConfig {
 impl IdentConfig {
     /// Reads a config file.
     pub fn from_file(path: &Path) -> Result<IdentConfig, IdentError> {
-        let name = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| IdentError::Test {
-            input: name.clone(),
-            message: format!("cannot read: {e}"),
-        })?;
-        let mut c: IdentConfig = toml::from_str(&text)
-            .map_err(|e| crate::machine::MachineError::toml(&name, &text, &e))?;
+        let (name, mut c): (String, IdentConfig) = read_toml(path)?;
         c.source = Some(name);
         Ok(c)
     }
 
-    /// Applies the present keys, validating them.
+    /// Applies the present keys, validating them: each within the range an identification can
+    /// use (the error names the key, the file and the range).
     pub fn apply(&self, s: &mut Settings, m: &mut MeasuredOptions) -> Result<(), IdentError> {
         let from = self.source.clone().unwrap_or_else(|| "command line".into());
         let bad = |k: &str, v: String| IdentError::Test {
             input: from.clone(),
             message: format!("{k} = {v} is not allowed"),
+        };
+        let range = |k: &str, v: f64, lo: f64, hi: f64, unit: &str| {
+            if v.is_finite() && v > lo && v <= hi {
+                Ok(v)
+            } else {
+                Err(bad(
+                    k,
+                    format!("{}: must lie in ({}, {}]{unit}", num(v), num(lo), num(hi)),
+                ))
+            }
+        };
+        let whole = |k: &str, v: f64, hi: f64| {
+            let v = range(k, v, 0.0, hi, "")?;
+            if v.fract() != 0.0 {
+                return Err(bad(k, format!("{}: must be a whole number", num(v))));
+            }
+            Ok(v)
         };
         if let Some(v) = self.method {
             s.method = v;
@@ -87,59 +101,103 @@ impl IdentConfig {
             m.fit_time_offset = v;
         }
         if let Some(v) = self.max_iters {
-            if v == 0 {
-                return Err(bad("max_iters", v.to_string()));
-            }
-            s.max_iters = Some(v);
+            s.max_iters = Some(whole("max_iters", v, MAX_ITERS)? as u64);
         }
-        for (k, src, dst) in [
-            ("min_factor", self.min_factor, &mut s.min_factor),
-            ("tol_cost", self.tol_cost, &mut s.tol_cost),
-            ("tol_step", self.tol_step, &mut s.tol_step),
-            ("tol_noise", self.tol_noise, &mut s.tol_noise),
-            ("max_factor", self.max_factor, &mut s.max_factor),
-            ("rate_hz", self.rate_hz, &mut s.simulation.rate_hz),
-            ("radius_mm", self.radius_mm, &mut m.radius_mm),
+        if let Some(v) = self.revolutions {
+            s.simulation.revolutions = whole("revolutions", v, MAX_REVOLUTIONS)? as u32;
+        }
+        for (k, src, dst, hi, unit) in [
+            (
+                "min_factor",
+                self.min_factor,
+                &mut s.min_factor,
+                MAX_FACTOR,
+                "",
+            ),
+            ("tol_cost", self.tol_cost, &mut s.tol_cost, 1.0, ""),
+            ("tol_step", self.tol_step, &mut s.tol_step, 1.0, ""),
+            ("tol_noise", self.tol_noise, &mut s.tol_noise, 1.0, ""),
+            (
+                "max_factor",
+                self.max_factor,
+                &mut s.max_factor,
+                MAX_FACTOR,
+                "",
+            ),
+            (
+                "rate_hz",
+                self.rate_hz,
+                &mut s.simulation.rate_hz,
+                MAX_RATE_HZ,
+                " Hz",
+            ),
+            (
+                "radius_mm",
+                self.radius_mm,
+                &mut m.radius_mm,
+                3.0,
+                " mm (the R-Test's range)",
+            ),
             (
                 "table_std_err_um_s2_per_m",
                 self.table_std_err_um_s2_per_m,
                 &mut m.table_std_err,
+                1e6,
+                " µm·s²/m",
             ),
         ] {
             if let Some(v) = src {
-                if !(v.is_finite() && v > 0.0) {
-                    return Err(bad(k, v.to_string()));
-                }
-                *dst = v;
+                *dst = range(k, v, 0.0, hi, unit)?;
             }
-        }
-        if m.radius_mm > 3.0 {
-            return Err(bad(
-                "radius_mm",
-                format!("{} (beyond the R-Test's ±3 mm range)", m.radius_mm),
-            ));
-        }
-        if let Some(v) = self.revolutions {
-            if v == 0 {
-                return Err(bad("revolutions", v.to_string()));
-            }
-            s.simulation.revolutions = v;
         }
         if let Some(p) = &self.position_mm {
-            if p.iter().any(|v| !v.is_finite()) {
-                return Err(bad("position_mm", format!("{p:?}")));
+            if p.len() > 3 || p.iter().any(|v| !(v.is_finite() && v.abs() <= 1e5)) {
+                return Err(bad(
+                    "position_mm",
+                    format!(
+                        "{}: give one finite position per machine axis (at most 3, within ±1e5 mm)",
+                        crate::text::nums(p)
+                    ),
+                ));
             }
             s.simulation.position_m = Some(p.iter().map(|v| v * 1e-3).collect());
         }
         if s.min_factor >= s.max_factor {
             return Err(bad(
                 "min_factor",
-                format!("{} (not below max_factor {})", s.min_factor, s.max_factor),
+                format!(
+                    "{} (not below max_factor {})",
+                    num(s.min_factor),
+                    num(s.max_factor)
+                ),
             ));
         }
         Ok(())
     }
 }
+
+/// Reads a TOML file (within the size limit of description files): its name and its content.
+fn read_toml<T: serde::de::DeserializeOwned>(path: &Path) -> Result<(String, T), IdentError> {
+    let name = path.display().to_string();
+    let text = crate::io::read_input_text(path, crate::io::read::MAX_TEXT_BYTES).map_err(|e| {
+        IdentError::Test {
+            input: name.clone(),
+            message: format!("cannot read: {e}"),
+        }
+    })?;
+    let value =
+        toml::from_str(&text).map_err(|e| crate::machine::MachineError::toml(&name, &text, &e))?;
+    Ok((name, value))
+}
+
+/// Most optimiser iterations a config may ask for.
+pub const MAX_ITERS: f64 = 1e6;
+/// Most steady revolutions per simulated test.
+pub const MAX_REVOLUTIONS: f64 = 1000.0;
+/// Highest output rate of the simulated tests, Hz.
+pub const MAX_RATE_HZ: f64 = 1e6;
+/// Largest bound of a reduction factor.
+pub const MAX_FACTOR: f64 = 1000.0;
 
 /// An expected identified value with its tolerance.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -171,13 +229,27 @@ pub struct KnownGood {
 impl KnownGood {
     /// Reads a known-good file and resolves its paths relative to it.
     pub fn from_file(path: &Path) -> Result<KnownGood, IdentError> {
-        let name = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| IdentError::Test {
-            input: name.clone(),
-            message: format!("cannot read: {e}"),
-        })?;
-        let mut k: KnownGood = toml::from_str(&text)
-            .map_err(|e| crate::machine::MachineError::toml(&name, &text, &e))?;
+        let (name, mut k): (String, KnownGood) = read_toml(path)?;
+        k.settings.source = Some(name.clone());
+        for (param, e) in &k.expected {
+            let bad = |what: &str, v: f64, rule: &str| IdentError::Test {
+                input: name.clone(),
+                message: format!(
+                    "expected.\"{param}\".{what} = {} is not allowed: {rule}",
+                    num(v)
+                ),
+            };
+            if !(e.value.is_finite() && e.value > 0.0) {
+                return Err(bad("value", e.value, "a factor must be finite and > 0"));
+            }
+            if !(e.rel_tol.is_finite() && e.rel_tol > 0.0 && e.rel_tol < 1.0) {
+                return Err(bad(
+                    "rel_tol",
+                    e.rel_tol,
+                    "a relative tolerance must lie in (0, 1)",
+                ));
+            }
+        }
         let dir = path.parent().unwrap_or(Path::new("."));
         k.machine = dir.join(&k.machine);
         k.measured = k.measured.iter().map(|m| dir.join(m)).collect();

@@ -36,6 +36,8 @@ impl CarriageData {
 #[derive(Debug, Clone, Default)]
 pub struct Catalogue {
     entries: BTreeMap<String, CarriageData>,
+    /// The file each entry came from.
+    files: BTreeMap<String, String>,
 }
 
 impl Catalogue {
@@ -57,10 +59,23 @@ impl Catalogue {
                 ("reverse_radial_n_per_um", c.reverse_radial_n_per_um),
                 ("lateral_n_per_um", c.lateral_n_per_um),
             ] {
-                if !(v.is_finite() && v > 0.0) {
-                    return Err(MachineError::new(file, key(k), format!("{v} must be > 0")));
+                if !(v.is_finite() && v > 0.0 && v <= 1e5) {
+                    return Err(MachineError::new(
+                        file,
+                        key(k),
+                        format!("{} must lie in (0, 1e5] N/µm", crate::text::num(v)),
+                    ));
                 }
             }
+            // One value per id: a second entry would silently change every machine using it.
+            if let Some(first) = self.files.get(&c.id) {
+                return Err(MachineError::new(
+                    file,
+                    key("id"),
+                    format!("already defined in {first}; give this entry its own id"),
+                ));
+            }
+            self.files.insert(c.id.clone(), file.to_string());
             self.entries.insert(
                 c.id.clone(),
                 CarriageData {

@@ -378,17 +378,17 @@ impl Machine {
     /// Reads and validates a machine file; extra catalogues are resolved relative to it.
     pub fn from_file(path: &Path) -> Result<Self, MachineError> {
         let file = path.display().to_string();
-        if path.is_dir() {
-            return Err(MachineError::new(&file, "file", "is a folder, not a file"));
-        }
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| MachineError::new(&file, "file", format!("cannot read: {e}")))?;
+        let max = crate::io::read::MAX_TEXT_BYTES;
+        let text = crate::io::read_input_text(path, max).map_err(|e| match e {
+            crate::io::ReadError::IsAFolder => MachineError::new(&file, "file", e.to_string()),
+            e => MachineError::new(&file, "file", format!("cannot read: {e}")),
+        })?;
         let raw: RawMachine =
             toml::from_str(&text).map_err(|e| MachineError::toml(&file, &text, &e))?;
         let mut catalogue = Catalogue::bundled()?;
         for (i, extra) in raw.catalogue.iter().enumerate() {
             let p = path.parent().unwrap_or(Path::new(".")).join(extra);
-            let t = std::fs::read_to_string(&p).map_err(|e| {
+            let t = crate::io::read_input_text(&p, max).map_err(|e| {
                 MachineError::new(
                     &file,
                     format!("catalogue[{i}]"),

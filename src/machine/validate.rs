@@ -25,9 +25,8 @@ impl Machine {
         file: &str,
     ) -> Result<Self, MachineError> {
         let err = |key: String, msg: String| MachineError::new(file, key, msg);
-        if !(raw.rayleigh_beta_s.is_finite() && raw.rayleigh_beta_s >= 0.0) {
-            return Err(err("rayleigh_beta_s".into(), "must be ≥ 0".into()));
-        }
+        non_negative(raw.rayleigh_beta_s, "rayleigh_beta_s".into(), Max(1.0, "s"))
+            .map_err(|(k, m)| err(k, m))?;
         let mut bodies = Vec::with_capacity(raw.bodies.len());
         for (i, b) in raw.bodies.iter().enumerate() {
             let key = |k: &str| format!("body[{}].{k}", b.name);
@@ -38,9 +37,7 @@ impl Machine {
                 return Err(err(key("name"), "duplicate body name".into()));
             }
             let cog = b.cog_m.unwrap_or([0.0; 3]);
-            if !finite3(cog) {
-                return Err(err(key("cog_m"), "must be finite".into()));
-            }
+            coords(&cog).map_err(|m| err(key("cog_m"), m))?;
             if b.fixed {
                 bodies.push(Body {
                     name: b.name.clone(),
@@ -54,9 +51,7 @@ impl Machine {
             let mass = b
                 .mass_kg
                 .ok_or_else(|| err(key("mass_kg"), "missing (free bodies need a mass)".into()))?;
-            if !(mass.is_finite() && mass > 0.0) {
-                return Err(err(key("mass_kg"), format!("{mass} must be > 0")));
-            }
+            positive(mass, key("mass_kg"), Max(1e6, "kg")).map_err(|(k, m)| err(k, m))?;
             if b.cog_m.is_none() {
                 return Err(err(
                     key("cog_m"),
@@ -84,9 +79,7 @@ impl Machine {
         };
         let point = |p: &raw::RawBodyPoint, what: &str| -> Result<BodyPoint, MachineError> {
             let body = body_index(&p.body, format!("{what}.body"))?;
-            if !finite3(p.point_m) {
-                return Err(err(format!("{what}.point_m"), "must be finite".into()));
-            }
+            coords(&p.point_m).map_err(|m| err(format!("{what}.point_m"), m))?;
             Ok(BodyPoint {
                 body,
                 point_m: Vector3::from(p.point_m),
@@ -145,16 +138,21 @@ impl Machine {
             }
             moved_by[moving] = Some(i);
             let [lo, hi] = ra.stroke_m;
-            if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+            coords(&ra.stroke_m).map_err(|m| err(key("stroke_m"), m))?;
+            if lo >= hi {
                 return Err(err(
                     key("stroke_m"),
-                    format!("[{lo}, {hi}] must be finite with min < max"),
+                    format!("{} must have min < max", crate::text::nums(&ra.stroke_m)),
                 ));
             }
             if !(ra.reference_m.is_finite() && lo <= ra.reference_m && ra.reference_m <= hi) {
                 return Err(err(
                     key("reference_m"),
-                    format!("{} outside the stroke [{lo}, {hi}]", ra.reference_m),
+                    format!(
+                        "{} outside the stroke {}",
+                        crate::text::num(ra.reference_m),
+                        crate::text::nums(&ra.stroke_m)
+                    ),
                 ));
             }
             let e = Vector3::from(axis.unit());
@@ -240,15 +238,26 @@ impl Machine {
                     "the two bodies move relative to each other along an axis".into(),
                 ));
             }
-            if !finite3(j.point_m) {
-                return Err(err(key("point_m"), "must be finite".into()));
-            }
-            for (k, v) in [
-                ("stiffness_n_per_m", j.stiffness_n_per_m),
-                ("damping_n_s_per_m", j.damping_n_s_per_m),
+            coords(&j.point_m).map_err(|m| err(key("point_m"), m))?;
+            for (k, v, max) in [
+                ("stiffness_n_per_m", j.stiffness_n_per_m, 1e13),
+                ("damping_n_s_per_m", j.damping_n_s_per_m, DAMPING.0),
             ] {
                 if !v.iter().all(|x| x.is_finite() && *x >= 0.0) {
-                    return Err(err(key(k), format!("{v:?}: values must be ≥ 0")));
+                    return Err(err(
+                        key(k),
+                        format!("{}: values must be ≥ 0", crate::text::nums(&v)),
+                    ));
+                }
+                if v.iter().any(|x| *x > max) {
+                    return Err(err(
+                        key(k),
+                        format!(
+                            "{}: beyond {}, more than any machine tool has (a typo or a unit slip?)",
+                            crate::text::nums(&v),
+                            crate::text::num(max)
+                        ),
+                    ));
                 }
             }
             joints.push(Joint {
@@ -291,6 +300,12 @@ fn check_inertia(j: &Matrix3<f64>) -> Result<(), String> {
             principal[0], principal[1], principal[2]
         ));
     }
+    if principal.max() > 1e7 {
+        return Err(format!(
+            "principal moment {} kg·m² is beyond 1e7 kg·m², more than any machine tool has (a typo or a unit slip?)",
+            crate::text::num(principal.max())
+        ));
+    }
     let sum = principal.sum();
     if principal.iter().any(|&p| p > 0.5 * sum * (1.0 + 1e-9)) {
         return Err(format!(
@@ -303,20 +318,57 @@ fn check_inertia(j: &Matrix3<f64>) -> Result<(), String> {
 
 type FieldError = (String, String);
 
-fn positive(v: f64, key: String) -> Result<f64, FieldError> {
-    if v.is_finite() && v > 0.0 {
-        Ok(v)
-    } else {
-        Err((key, format!("{v} must be > 0")))
+/// Largest value of a quantity in any machine tool, with its unit: beyond it a value is a typo
+/// or a unit slip, and is named as such before it can surface as a numerical failure.
+#[derive(Clone, Copy)]
+struct Max(f64, &'static str);
+
+const COORD: Max = Max(100.0, "m");
+const STIFFNESS_N_PER_UM: Max = Max(1e5, "N/µm");
+const FACTOR: Max = Max(100.0, "(times the file value)");
+const DAMPING: Max = Max(1e9, "N·s/m");
+const LENGTH: Max = Max(10.0, "m");
+
+fn in_range(v: f64, key: String, positive: bool, max: Max) -> Result<f64, FieldError> {
+    let v_text = crate::text::num(v);
+    if !(v.is_finite() && (v > 0.0 || (!positive && v == 0.0))) {
+        let rel = if positive { ">" } else { "≥" };
+        return Err((key, format!("{v_text} must be {rel} 0")));
     }
+    if v > max.0 {
+        return Err((
+            key,
+            format!(
+                "{v_text} is beyond {} {}, more than any machine tool has (a typo or a unit slip?)",
+                crate::text::num(max.0),
+                max.1
+            ),
+        ));
+    }
+    Ok(v)
 }
 
-fn non_negative(v: f64, key: String) -> Result<f64, FieldError> {
-    if v.is_finite() && v >= 0.0 {
-        Ok(v)
-    } else {
-        Err((key, format!("{v} must be ≥ 0")))
+fn positive(v: f64, key: String, max: Max) -> Result<f64, FieldError> {
+    in_range(v, key, true, max)
+}
+
+fn non_negative(v: f64, key: String, max: Max) -> Result<f64, FieldError> {
+    in_range(v, key, false, max)
+}
+
+/// Every coordinate finite and within [`COORD`].
+fn coords(p: &[f64]) -> Result<(), String> {
+    if !p.iter().all(|x| x.is_finite()) {
+        return Err("must be finite".into());
     }
+    if p.iter().any(|x| x.abs() > COORD.0) {
+        return Err(format!(
+            "{} m lies beyond ±{} m, farther than any machine tool reaches (mm given as m?)",
+            crate::text::nums(p),
+            COORD.0
+        ));
+    }
+    Ok(())
 }
 
 fn validate_guideway(
@@ -340,8 +392,8 @@ fn validate_guideway(
         }
         (None, Some(n), Some(l)) => (
             None,
-            positive(n, key("stiffness_normal_n_per_um"))? * 1e6,
-            positive(l, key("stiffness_lateral_n_per_um"))? * 1e6,
+            positive(n, key("stiffness_normal_n_per_um"), STIFFNESS_N_PER_UM)? * 1e6,
+            positive(l, key("stiffness_lateral_n_per_um"), STIFFNESS_N_PER_UM)? * 1e6,
         ),
         _ => {
             return Err((
@@ -350,12 +402,17 @@ fn validate_guideway(
             ))
         }
     };
-    let reduction_normal = positive(g.reduction_normal, key("reduction_normal"))?;
-    let reduction_lateral = positive(g.reduction_lateral, key("reduction_lateral"))?;
-    let damping_normal = non_negative(g.damping_normal_n_s_per_m, key("damping_normal_n_s_per_m"))?;
+    let reduction_normal = positive(g.reduction_normal, key("reduction_normal"), FACTOR)?;
+    let reduction_lateral = positive(g.reduction_lateral, key("reduction_lateral"), FACTOR)?;
+    let damping_normal = non_negative(
+        g.damping_normal_n_s_per_m,
+        key("damping_normal_n_s_per_m"),
+        DAMPING,
+    )?;
     let damping_lateral = non_negative(
         g.damping_lateral_n_s_per_m,
         key("damping_lateral_n_s_per_m"),
+        DAMPING,
     )?;
     if g.rails.is_empty() {
         return Err((key("rail"), "at least one rail is needed".into()));
@@ -376,7 +433,10 @@ fn validate_guideway(
                 "must be perpendicular to the axis".into(),
             ));
         }
-        if rail.carriages_m.is_empty() || !rail.carriages_m.iter().all(|p| finite3(*p)) {
+        if let Some(m) = rail.carriages_m.iter().find_map(|p| coords(p).err()) {
+            return Err((key(&format!("rail[{r}].carriages_m")), m));
+        }
+        if rail.carriages_m.is_empty() {
             return Err((
                 key(&format!("rail[{r}].carriages_m")),
                 "at least one carriage with finite coordinates is needed".into(),
@@ -406,21 +466,19 @@ fn validate_drive(d: &raw::RawDrive, key: &dyn Fn(&str) -> String) -> Result<Dri
         ("bearing_m", d.bearing_m),
         ("scale_m", d.scale_m),
     ] {
-        if !finite3(p) {
-            return Err((key(k), "must be finite".into()));
-        }
+        coords(&p).map_err(|m| (key(k), m))?;
     }
-    let diameter = positive(d.screw_diameter_m, key("screw_diameter_m"))?;
+    let diameter = positive(d.screw_diameter_m, key("screw_diameter_m"), Max(1.0, "m"))?;
     let drive = Drive {
         nut_m: Vector3::from(d.nut_m),
         bearing_m: Vector3::from(d.bearing_m),
         scale_m: Vector3::from(d.scale_m),
-        lead_m: positive(d.lead_m, key("lead_m"))?,
+        lead_m: positive(d.lead_m, key("lead_m"), Max(1.0, "m"))?,
         screw_area_m2: std::f64::consts::PI * diameter * diameter / 4.0,
-        screw_modulus_pa: positive(d.screw_modulus_pa, key("screw_modulus_pa"))?,
+        screw_modulus_pa: positive(d.screw_modulus_pa, key("screw_modulus_pa"), Max(1e13, "Pa"))?,
         support: d.support,
         screw_length_m: match (d.support, d.screw_length_m) {
-            (Support::FixedFixed, Some(l)) => Some(positive(l, key("screw_length_m"))?),
+            (Support::FixedFixed, Some(l)) => Some(positive(l, key("screw_length_m"), LENGTH)?),
             (Support::FixedFixed, None) => {
                 return Err((
                     key("screw_length_m"),
@@ -432,16 +490,28 @@ fn validate_drive(d: &raw::RawDrive, key: &dyn Fn(&str) -> String) -> Result<Dri
             }
             (Support::FixedFree, None) => None,
         },
-        nut_stiffness_n_per_m: positive(d.nut_stiffness_n_per_um, key("nut_stiffness_n_per_um"))?
-            * 1e6,
+        nut_stiffness_n_per_m: positive(
+            d.nut_stiffness_n_per_um,
+            key("nut_stiffness_n_per_um"),
+            STIFFNESS_N_PER_UM,
+        )? * 1e6,
         bearing_stiffness_n_per_m: positive(
             d.bearing_stiffness_n_per_um,
             key("bearing_stiffness_n_per_um"),
+            STIFFNESS_N_PER_UM,
         )? * 1e6,
-        reduction: positive(d.reduction, key("reduction"))?,
-        damping_n_s_per_m: non_negative(d.damping_n_s_per_m, key("damping_n_s_per_m"))?,
-        rotor_inertia_kg_m2: positive(d.rotor_inertia_kg_m2, key("rotor_inertia_kg_m2"))?,
-        friction_nm_s_per_rad: non_negative(d.friction_nm_s_per_rad, key("friction_nm_s_per_rad"))?,
+        reduction: positive(d.reduction, key("reduction"), FACTOR)?,
+        damping_n_s_per_m: non_negative(d.damping_n_s_per_m, key("damping_n_s_per_m"), DAMPING)?,
+        rotor_inertia_kg_m2: positive(
+            d.rotor_inertia_kg_m2,
+            key("rotor_inertia_kg_m2"),
+            Max(100.0, "kg·m²"),
+        )?,
+        friction_nm_s_per_rad: non_negative(
+            d.friction_nm_s_per_rad,
+            key("friction_nm_s_per_rad"),
+            Max(1e6, "N·m·s/rad"),
+        )?,
     };
     Ok(drive)
 }
@@ -472,16 +542,29 @@ fn validate_control(
     key: &dyn Fn(&str) -> String,
 ) -> Result<Control, FieldError> {
     Ok(Control {
-        kv_per_s: positive(c.kv_per_s, key("kv_per_s"))?,
-        kp_nm_s_per_rad: positive(c.kp_nm_s_per_rad, key("kp_nm_s_per_rad"))?,
-        tn_s: positive(c.tn_s, key("tn_s"))?,
-        current_lag_s: non_negative(c.current_lag_s, key("current_lag_s"))?,
-        setpoint_filter_s: non_negative(c.setpoint_filter_s, key("setpoint_filter_s"))?,
+        kv_per_s: positive(c.kv_per_s, key("kv_per_s"), Max(1e4, "1/s"))?,
+        kp_nm_s_per_rad: positive(
+            c.kp_nm_s_per_rad,
+            key("kp_nm_s_per_rad"),
+            Max(1e6, "N·m·s/rad"),
+        )?,
+        tn_s: positive(c.tn_s, key("tn_s"), Max(100.0, "s"))?,
+        current_lag_s: non_negative(c.current_lag_s, key("current_lag_s"), Max(0.1, "s"))?,
+        setpoint_filter_s: non_negative(
+            c.setpoint_filter_s,
+            key("setpoint_filter_s"),
+            Max(10.0, "s"),
+        )?,
         feedback: c.feedback,
-        velocity_feedforward: non_negative(c.velocity_feedforward, key("velocity_feedforward"))?,
+        velocity_feedforward: non_negative(
+            c.velocity_feedforward,
+            key("velocity_feedforward"),
+            Max(2.0, ""),
+        )?,
         acceleration_feedforward: non_negative(
             c.acceleration_feedforward,
             key("acceleration_feedforward"),
+            Max(2.0, ""),
         )?,
     })
 }

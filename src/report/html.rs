@@ -304,12 +304,13 @@ pub fn generate(req: &ReportRequest) -> Result<Vec<PathBuf>, ReportError> {
             path: out_name,
             message: format!("cannot create folder: {e}"),
         })?;
-    let mut written = Vec::new();
-    for (name, bytes) in &outputs {
-        let path = out.join(name);
-        crate::io::write_atomic(&path, bytes, &inputs)?;
-        written.push(path);
-    }
+    let written: Vec<PathBuf> = outputs.iter().map(|(name, _)| out.join(name)).collect();
+    let files: Vec<(&Path, &[u8])> = written
+        .iter()
+        .zip(&outputs)
+        .map(|(p, (_, b))| (p.as_path(), b.as_slice()))
+        .collect();
+    crate::io::write_set(&files, &inputs)?;
     Ok(written)
 }
 

@@ -113,13 +113,26 @@ impl TestConditions {
     /// The conditions of the files in `dir`: its `rtest.toml`, or none.
     pub fn of_folder(dir: &Path) -> Result<TestConditions, RtestError> {
         let path = dir.join(CONDITIONS_FILE);
-        if !path.is_file() {
+        if std::fs::symlink_metadata(&path).is_err() {
             return Ok(TestConditions::default());
         }
         let name = path.display().to_string();
-        let text = std::fs::read_to_string(&path).map_err(|e| RtestError::Io {
+        // A folder, a device or a broken link of that name is a mistake, never "no conditions".
+        if !path.is_file() {
+            let what = match std::fs::metadata(&path) {
+                Err(_) => "a broken symbolic link",
+                Ok(m) if m.is_dir() => "a folder",
+                Ok(_) => "not a regular file",
+            };
+            return Err(RtestError::Io {
+                path: name,
+                message: format!("is {what}; the conditions file must be a TOML file"),
+            });
+        }
+        let bytes = super::series::read_bounded(&path, crate::io::read::MAX_TEXT_BYTES)?;
+        let text = String::from_utf8(bytes).map_err(|_| RtestError::Io {
             path: name.clone(),
-            message: e.to_string(),
+            message: "not valid UTF-8 text".into(),
         })?;
         let mut c = TestConditions::from_toml_str(&text, &name)?;
         for t in &mut c.tests {

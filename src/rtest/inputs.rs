@@ -10,6 +10,7 @@ use super::layout::ColumnMap;
 use super::series::CircleSeries;
 use super::RtestError;
 use crate::axes::{Direction, Plane};
+use crate::io::FileId;
 
 /// One circle test to read and evaluate, with everything known about its conditions.
 #[derive(Debug, Clone, PartialEq)]
@@ -53,6 +54,16 @@ impl TestInput {
                 format!("{} + {}", internal.display(), external.display())
             }
         }
+    }
+
+    /// Every file the test is read from: its recording(s) and its `rtest.toml`.
+    pub fn files(&self) -> Vec<PathBuf> {
+        let mut v = match &self.recording {
+            Recording::Single(f) => vec![f.clone()],
+            Recording::Split { internal, external } => vec![internal.clone(), external.clone()],
+        };
+        v.extend(self.conditions_file.clone());
+        v
     }
 
     /// The file that orders and labels the test: its file, or its internal file.
@@ -121,29 +132,56 @@ fn entry_files(e: &TestEntry) -> Vec<(&'static str, &Path)> {
     }
 }
 
-/// Checks that every file of the folder's entries exists.
+/// Checks that every file of the folder's entries exists and that no two entries name the
+/// same file (by identity: `a.csv`, `./a.csv` and a link to it are one file).
 fn check_entries(cond: &TestConditions) -> Result<(), RtestError> {
     let file = cond
         .file
         .as_ref()
         .map_or(String::new(), |f| f.display().to_string());
+    let mut seen: Vec<(FileId, String)> = Vec::new();
     for e in &cond.tests {
         for (key, path) in entry_files(e) {
-            if !path.is_file() {
-                return Err(RtestError::Conditions {
-                    file: file.clone(),
-                    key: format!("[[test]] #{} {key}", e.number),
-                    message: format!("{}: file not found", path.display()),
-                });
+            let at = format!("[[test]] #{} {key}", e.number);
+            let bad = |message: String| RtestError::Conditions {
+                file: file.clone(),
+                key: at.clone(),
+                message,
+            };
+            if path.is_dir() {
+                return Err(bad(format!("{}: is a folder, not a file", path.display())));
             }
+            let Some(id) = FileId::of(path) else {
+                return Err(bad(format!("{}: file not found", path.display())));
+            };
+            if let Some((_, first)) = seen.iter().find(|(i, _)| *i == id) {
+                return Err(bad(format!(
+                    "{}: already named by {first} (each file is one test)",
+                    path.display()
+                )));
+            }
+            seen.push((id, at));
         }
     }
     Ok(())
 }
 
+/// Most tests one command reads (files named, found in folders and in `[[test]]` tables).
+pub const MAX_TESTS: usize = 10_000;
+
 /// The tests of a folder (its entries and the CSV files no entry names) and, recursively, of
-/// its sub-folders, in path order.
-fn folder_tests(dir: &Path) -> Result<Vec<TestInput>, RtestError> {
+/// its sub-folders, in path order. `ancestors` are the folders above it (by identity): a
+/// folder inside itself (a symbolic-link loop) is an error, not a copy of its data.
+fn folder_tests(dir: &Path, ancestors: &mut Vec<FileId>) -> Result<Vec<TestInput>, RtestError> {
+    if let Some(id) = FileId::of(dir) {
+        if ancestors.contains(&id) {
+            return Err(RtestError::Io {
+                path: dir.display().to_string(),
+                message: "the folder lies inside itself (a symbolic-link loop)".into(),
+            });
+        }
+        ancestors.push(id);
+    }
     let mut paths: Vec<PathBuf> = std::fs::read_dir(dir)
         .map_err(|e| RtestError::Io {
             path: dir.display().to_string(),
@@ -169,7 +207,7 @@ fn folder_tests(dir: &Path) -> Result<Vec<TestInput>, RtestError> {
         .collect();
     for p in paths {
         if p.is_dir() {
-            items.push((p.clone(), folder_tests(&p)?));
+            items.push((p.clone(), folder_tests(&p, ancestors)?));
         } else if p.extension().is_some_and(|x| x.eq_ignore_ascii_case("csv"))
             && !named.contains(&p)
         {
@@ -178,9 +216,20 @@ fn folder_tests(dir: &Path) -> Result<Vec<TestInput>, RtestError> {
                 vec![TestInput::new(Recording::Single(p), &cond, dir)],
             ));
         }
+        if items.len() > MAX_TESTS {
+            return Err(too_many(dir));
+        }
     }
+    ancestors.pop();
     items.sort_by(|a, b| a.0.cmp(&b.0));
     Ok(items.into_iter().flat_map(|(_, t)| t).collect())
+}
+
+fn too_many(path: &Path) -> RtestError {
+    RtestError::Io {
+        path: path.display().to_string(),
+        message: format!("more than {MAX_TESTS} tests"),
+    }
 }
 
 /// The test a file given on its own belongs to: its `[[test]]` entry (a two-system test when
@@ -223,7 +272,7 @@ pub fn expand_tests(paths: &[PathBuf]) -> Result<Vec<TestInput>, RtestError> {
     let mut tests: Vec<TestInput> = Vec::new();
     for p in paths {
         if p.is_dir() {
-            let inside = folder_tests(p)?;
+            let inside = folder_tests(p, &mut Vec::new())?;
             if inside.is_empty() {
                 return Err(RtestError::Io {
                     path: p.display().to_string(),
@@ -231,7 +280,8 @@ pub fn expand_tests(paths: &[PathBuf]) -> Result<Vec<TestInput>, RtestError> {
                 });
             }
             tests.extend(inside);
-        } else if p.is_file() {
+        } else if std::fs::metadata(p).is_ok() {
+            // A file, or a pipe or device read like one (within the size limit).
             let t = file_test(p)?;
             let twice = matches!(t.recording, Recording::Split { .. })
                 && tests.iter().any(|o| o.recording == t.recording);
@@ -244,8 +294,38 @@ pub fn expand_tests(paths: &[PathBuf]) -> Result<Vec<TestInput>, RtestError> {
                 message: "file not found".into(),
             });
         }
+        if tests.len() > MAX_TESTS {
+            return Err(too_many(p));
+        }
     }
+    once_each(&tests)?;
     Ok(tests)
+}
+
+/// Refuses a measured file reached twice (named twice, in two folders given, through a link):
+/// it would count twice and make the standard errors too small.
+fn once_each(tests: &[TestInput]) -> Result<(), RtestError> {
+    let mut seen: Vec<(FileId, &Path)> = Vec::new();
+    for t in tests {
+        let files: Vec<&Path> = match &t.recording {
+            Recording::Single(f) => vec![f],
+            Recording::Split { internal, external } => vec![internal, external],
+        };
+        for f in files {
+            let Some(id) = FileId::of(f) else { continue };
+            if let Some((_, first)) = seen.iter().find(|(i, _)| *i == id) {
+                return Err(RtestError::Io {
+                    path: f.display().to_string(),
+                    message: format!(
+                        "the same file as {} (each measured file counts once)",
+                        first.display()
+                    ),
+                });
+            }
+            seen.push((id, f));
+        }
+    }
+    Ok(())
 }
 
 /// The files of the measured inputs of a command (every file of every test of

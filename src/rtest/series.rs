@@ -298,27 +298,20 @@ fn mapped_names(names: &[String]) -> Option<Box<[String; 7]>> {
     differ.then(|| Box::new(names))
 }
 
-/// Reads a whole file, telling "not found" and "is a folder" apart from other failures.
+/// Reads a whole measured file (at most [`crate::io::read::MAX_SERIES_BYTES`]), telling "not
+/// found" and "is a folder" apart from other failures.
 pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>, RtestError> {
+    read_bounded(path, crate::io::read::MAX_SERIES_BYTES)
+}
+
+/// Reads a whole input file of at most `max_bytes` bytes ([`crate::io::read_input`]).
+pub(crate) fn read_bounded(path: &Path, max_bytes: u64) -> Result<Vec<u8>, RtestError> {
     let name = path.display().to_string();
-    match std::fs::metadata(path) {
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            return Err(RtestError::Io {
-                path: name,
-                message: "file not found".into(),
-            })
-        }
-        Err(e) => {
-            return Err(RtestError::Io {
-                path: name,
-                message: e.to_string(),
-            })
-        }
-        Ok(m) if m.is_dir() => return Err(RtestError::NotAFile { path: name }),
-        Ok(_) => {}
-    }
-    std::fs::read(path).map_err(|e| RtestError::Io {
-        path: name,
-        message: e.to_string(),
+    crate::io::read_input(path, max_bytes).map_err(|e| match e {
+        crate::io::ReadError::IsAFolder => RtestError::NotAFile { path: name },
+        e => RtestError::Io {
+            path: name,
+            message: e.to_string(),
+        },
     })
 }

@@ -7,14 +7,27 @@ use std::path::Path;
 
 use super::error::{quote_cell, Location, RtestError};
 use super::layout::{csv_error, parse_decimal, LineCounter};
-use super::series::{column_indices, read_file, require_columns};
+use super::series::{column_indices, read_bounded, require_columns};
 use super::CircleResult;
 use crate::axes::{Direction, Eij, Plane};
 
 /// Whether a file looks like an EIJ table (its header has a `parameter` column) rather than a
 /// time series.
 pub fn looks_like_table(path: &Path) -> bool {
-    std::fs::read(path)
+    // The header is found within the first lines; a pipe or a device is never sniffed (what
+    // is read from it would be lost to the reader).
+    let head = |path: &Path| -> std::io::Result<Vec<u8>> {
+        use std::io::Read;
+        let mut b = Vec::new();
+        std::fs::File::open(path)?
+            .take(1 << 20)
+            .read_to_end(&mut b)?;
+        Ok(b)
+    };
+    if !path.is_file() {
+        return false;
+    }
+    head(path)
         .map(|b| {
             let sep = super::layout::header_separator(&b);
             super::layout::header_line(&b).is_some_and(|line| {
@@ -79,7 +92,7 @@ pub fn rows_from_result(result: &CircleResult) -> Vec<EijRow> {
 /// comma where `,` is not the separator) and `#` comment lines are recognised.
 pub fn read(path: impl AsRef<Path>) -> Result<Vec<EijRow>, RtestError> {
     let path = path.as_ref();
-    let bytes = read_file(path)?;
+    let bytes = read_bounded(path, crate::io::read::MAX_TEXT_BYTES)?;
     from_bytes(&path.display().to_string(), &bytes)
 }
 

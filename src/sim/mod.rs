@@ -147,7 +147,16 @@ fn run_piecewise(pieces: &[Piece], setpoint: &dyn SetPoint) -> Result<Run, SimEr
             "segments with different step sizes".into(),
         ));
     }
-    let steps = (setpoint.duration_s() / h).ceil() as usize;
+    let steps = (setpoint.duration_s() / h).ceil();
+    if !(steps.is_finite() && steps < MAX_SAMPLES as f64) {
+        return Err(SimError::Invalid(format!(
+            "{} s at {} Hz would be {} samples, at most {MAX_SAMPLES} are simulated",
+            crate::text::num(setpoint.duration_s()),
+            crate::text::num(1.0 / h),
+            crate::text::num(steps)
+        )));
+    }
+    let steps = steps as usize;
     let (nu, nx, ny) = (cl0.b.ncols(), cl0.a.nrows(), cl0.c.nrows());
     let mut u_now = DVector::zeros(nu);
     let mut u_next = DVector::zeros(nu);
@@ -189,6 +198,10 @@ fn run_piecewise(pieces: &[Piece], setpoint: &dyn SetPoint) -> Result<Run, SimEr
     }
     Ok(run)
 }
+
+/// Most samples one simulation computes (bounds its memory: each sample holds every input
+/// and output of the closed loop).
+pub const MAX_SAMPLES: usize = 2_000_000;
 
 /// One stretch of a run: start time, closed loop, discretisation and, for a long move, the set
 /// position (axis order, m) at which the closed loop was assembled.

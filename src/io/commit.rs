@@ -1,0 +1,336 @@
+//! Committing the outputs of a run together.
+//!
+//! 1. Every new file is written in full to a temporary file beside its target,
+//!    `.eij-<pid>-<n>.tmp` (short, whatever the target's name: a 255-byte name still fits),
+//!    with the permissions and owner of the file it replaces, and synced.
+//! 2. For more than one file, a journal `.eij-<pid>-<n>.commit` listing the renames is written
+//!    into every folder involved, and synced.
+//! 3. The temporary files are renamed over their targets, the folders synced, the journals
+//!    removed.
+//!
+//! Interrupt, terminate and hang-up signals that arrive during 1–3 are held until the commit
+//! ends, so such a kill leaves the old set (before 1) or the new set. Only a SIGKILL or a power
+//! loss can stop the commit half-way: then the next commit into one of those folders finds the
+//! journal of the dead process and completes its renames (or, without a complete journal,
+//! removes its temporary files), before writing its own outputs ([`recover`]).
+
+use super::{check_outputs, folder_of, WriteError};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+
+/// Prefix of every temporary name, for [`recover`] to find them.
+const PREFIX: &str = ".eij-";
+
+/// Numbers the temporary names of one process.
+static NEXT: AtomicUsize = AtomicUsize::new(0);
+
+/// One commit at a time per process (the signal handling is process-wide).
+static COMMIT: Mutex<()> = Mutex::new(());
+
+fn temp_name(dir: &Path, ext: &str) -> PathBuf {
+    let n = NEXT.fetch_add(1, Ordering::SeqCst);
+    dir.join(format!("{PREFIX}{}-{n}.{ext}", std::process::id()))
+}
+
+/// Checks that the folder of `path` takes new files, by creating and removing one.
+pub(super) fn probe_folder(path: &Path) -> Result<(), WriteError> {
+    let probe = temp_name(&folder_of(path), "tmp");
+    std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(&probe)
+        .map_err(|cause| WriteError::Io {
+            path: path.to_path_buf(),
+            cause,
+        })?;
+    let _ = std::fs::remove_file(&probe);
+    Ok(())
+}
+
+/// The journal of a commit: the renames, and every folder holding a copy of it.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct Journal {
+    renames: Vec<(PathBuf, PathBuf)>,
+    copies: Vec<PathBuf>,
+}
+
+/// Writes every `(path, bytes)` as one set (module docs): after an error, nothing of the set is
+/// written and every old file is as it was; after a commit stopped by a kill, the old set or
+/// (once recovered) the new set. `inputs` and every file the run has read are never replaced;
+/// every output is checked by [`check_outputs`] first.
+pub fn write_set(files: &[(&Path, &[u8])], inputs: &[&Path]) -> Result<(), WriteError> {
+    let paths: Vec<&Path> = files.iter().map(|(p, _)| *p).collect();
+    check_outputs(&paths, inputs)?;
+    let mut folders: Vec<PathBuf> = Vec::new();
+    for p in &paths {
+        let d = folder_of(p);
+        let d = d.canonicalize().unwrap_or(d);
+        if !folders.contains(&d) {
+            folders.push(d);
+        }
+    }
+    let _one = COMMIT.lock().unwrap_or_else(|e| e.into_inner());
+    for d in &folders {
+        recover(d);
+    }
+    let _held = signals::Held::new();
+    let mut staged: Vec<(PathBuf, PathBuf)> = Vec::new();
+    let remove_all = |staged: &[(PathBuf, PathBuf)], journals: &[PathBuf]| {
+        for (tmp, _) in staged {
+            let _ = std::fs::remove_file(tmp);
+        }
+        for j in journals {
+            let _ = std::fs::remove_file(j);
+        }
+    };
+    for (path, bytes) in files {
+        let target = folder_of(path)
+            .canonicalize()
+            .map(|d| d.join(path.file_name().unwrap_or_default()))
+            .unwrap_or_else(|_| path.to_path_buf());
+        let tmp = temp_name(&folder_of(&target), "tmp");
+        if let Err(cause) = stage(&tmp, &target, bytes) {
+            let _ = std::fs::remove_file(&tmp);
+            remove_all(&staged, &[]);
+            return Err(WriteError::Io {
+                path: path.to_path_buf(),
+                cause,
+            });
+        }
+        staged.push((tmp, target));
+    }
+    let journals = if staged.len() > 1 {
+        match write_journals(&staged, &folders) {
+            Ok(j) => j,
+            Err(cause) => {
+                remove_all(&staged, &[]);
+                return Err(WriteError::Io {
+                    path: folders[0].clone(),
+                    cause,
+                });
+            }
+        }
+    } else {
+        Vec::new()
+    };
+    for (i, (tmp, target)) in staged.iter().enumerate() {
+        if let Err(cause) = std::fs::rename(tmp, target) {
+            remove_all(&staged[i..], &journals);
+            return Err(WriteError::Io {
+                path: paths[i].to_path_buf(),
+                cause,
+            });
+        }
+    }
+    for d in &folders {
+        sync_folder(d);
+    }
+    remove_all(&[], &journals);
+    Ok(())
+}
+
+/// Writes `bytes` to the new file `tmp` with the permissions (and, where allowed, the owner)
+/// of `target` if it exists, and syncs it.
+fn stage(tmp: &Path, target: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let mut f = std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(tmp)?;
+    if let Ok(old) = std::fs::metadata(target) {
+        // Before the content goes in: a private file's new content is never readable by others.
+        f.set_permissions(old.permissions())?;
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::MetadataExt;
+            let _ = std::os::unix::fs::fchown(&f, Some(old.uid()), Some(old.gid()));
+        }
+    }
+    f.write_all(bytes)?;
+    f.sync_all()
+}
+
+fn write_journals(
+    staged: &[(PathBuf, PathBuf)],
+    folders: &[PathBuf],
+) -> std::io::Result<Vec<PathBuf>> {
+    let copies: Vec<PathBuf> = folders.iter().map(|d| temp_name(d, "commit")).collect();
+    let text = serde_json::to_vec(&Journal {
+        renames: staged.to_vec(),
+        copies: copies.clone(),
+    })?;
+    let mut written = Vec::new();
+    for c in &copies {
+        let result = std::fs::File::create(c).and_then(|mut f| {
+            f.write_all(&text)?;
+            f.sync_all()
+        });
+        written.push(c.clone());
+        if let Err(e) = result {
+            for w in &written {
+                let _ = std::fs::remove_file(w);
+            }
+            return Err(e);
+        }
+    }
+    for d in folders {
+        sync_folder(d);
+    }
+    Ok(written)
+}
+
+fn sync_folder(dir: &Path) {
+    if let Ok(f) = std::fs::File::open(dir) {
+        let _ = f.sync_all();
+    }
+}
+
+/// The process id in a temporary name `.eij-<pid>-<n>.<ext>`.
+fn owner(name: &str) -> Option<u32> {
+    name.strip_prefix(PREFIX)?.split('-').next()?.parse().ok()
+}
+
+/// Whether process `pid` still runs (then its temporary files are left alone).
+fn alive(pid: u32) -> bool {
+    if pid == std::process::id() {
+        return true;
+    }
+    #[cfg(unix)]
+    {
+        let Ok(p) = libc::pid_t::try_from(pid) else {
+            return false;
+        };
+        // SAFETY: signal 0 only checks that the process exists.
+        let r = unsafe { libc::kill(p, 0) };
+        r == 0 || std::io::Error::last_os_error().raw_os_error() == Some(libc::EPERM)
+    }
+    #[cfg(not(unix))]
+    {
+        true
+    }
+}
+
+/// Completes or undoes what a killed eij left in `dir`: a journal whose copies were all
+/// written is carried out (its temporary files become the new set), any other journal's
+/// temporary files are removed, and so is every other temporary file of a process that no
+/// longer runs. Called by every commit for its folders.
+pub fn recover(dir: &Path) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    let stale: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok())
+        .filter(|e| {
+            let name = e.file_name();
+            let name = name.to_string_lossy();
+            owner(&name).is_some_and(|pid| !alive(pid))
+        })
+        .map(|e| e.path())
+        .collect();
+    let read = |p: &Path| {
+        std::fs::read(p)
+            .ok()
+            .and_then(|b| serde_json::from_slice::<Journal>(&b).ok())
+    };
+    for j in stale
+        .iter()
+        .filter(|p| p.extension().is_some_and(|x| x == "commit"))
+    {
+        if let Some(journal) = read(j) {
+            // Committed only once every copy was written in full: then the renames are
+            // completed, else the new files are dropped and the old set stays.
+            let committed = journal
+                .copies
+                .iter()
+                .all(|c| read(c).is_some_and(|o| o.renames == journal.renames));
+            for (tmp, target) in &journal.renames {
+                if committed && tmp.is_file() {
+                    let _ = std::fs::rename(tmp, target);
+                } else {
+                    let _ = std::fs::remove_file(tmp);
+                }
+            }
+            for c in &journal.copies {
+                let _ = std::fs::remove_file(c);
+            }
+        }
+        let _ = std::fs::remove_file(j);
+    }
+    for t in stale
+        .iter()
+        .filter(|p| p.extension().is_some_and(|x| x == "tmp"))
+    {
+        let _ = std::fs::remove_file(t);
+    }
+}
+
+#[cfg(unix)]
+mod signals {
+    //! Interrupt, terminate, hang-up and quit held during a commit, delivered after it.
+    use std::sync::atomic::{AtomicI32, Ordering};
+
+    const HELD: [libc::c_int; 4] = [libc::SIGINT, libc::SIGTERM, libc::SIGHUP, libc::SIGQUIT];
+    static PENDING: AtomicI32 = AtomicI32::new(0);
+
+    extern "C" fn note(sig: libc::c_int) {
+        PENDING.store(sig, Ordering::SeqCst);
+    }
+
+    /// While alive, the signals are noted instead of acted on; dropped, the previous
+    /// dispositions return and a noted signal is raised again.
+    pub struct Held {
+        old: Vec<(libc::c_int, libc::sigaction)>,
+    }
+
+    impl Held {
+        pub fn new() -> Held {
+            let mut old = Vec::new();
+            for sig in HELD {
+                // SAFETY: plain sigaction calls with zero-initialised structs; the handler only
+                // stores into an atomic, which is async-signal-safe.
+                unsafe {
+                    let mut new: libc::sigaction = std::mem::zeroed();
+                    new.sa_sigaction = note as extern "C" fn(libc::c_int) as libc::sighandler_t;
+                    libc::sigemptyset(&mut new.sa_mask);
+                    let mut prev: libc::sigaction = std::mem::zeroed();
+                    if libc::sigaction(sig, &new, &mut prev) == 0 {
+                        old.push((sig, prev));
+                    }
+                }
+            }
+            Held { old }
+        }
+    }
+
+    impl Drop for Held {
+        fn drop(&mut self) {
+            for (sig, prev) in &self.old {
+                // SAFETY: restores the disposition saved in `new`.
+                unsafe {
+                    libc::sigaction(*sig, prev, std::ptr::null_mut());
+                }
+            }
+            let sig = PENDING.swap(0, Ordering::SeqCst);
+            if sig != 0 {
+                // SAFETY: re-raises a signal that arrived during the commit, now under its
+                // previous disposition.
+                unsafe {
+                    libc::raise(sig);
+                }
+            }
+        }
+    }
+}
+
+#[cfg(not(unix))]
+mod signals {
+    /// Nothing to hold on this platform.
+    pub struct Held;
+
+    impl Held {
+        pub fn new() -> Held {
+            Held
+        }
+    }
+}
