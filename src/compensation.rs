@@ -288,7 +288,7 @@ impl CompensationTable {
             .from_reader(text.as_bytes());
         let header: Vec<String> = rdr
             .headers()
-            .map_err(|e| err("header".into(), e.to_string()))?
+            .map_err(|e| err("header".into(), crate::rtest::layout::csv_message(&e)))?
             .iter()
             .map(str::to_string)
             .collect();
@@ -315,7 +315,12 @@ impl CompensationTable {
         let worst_col = col(known[4]);
         let mut coefficients: Vec<Coefficient> = Vec::new();
         for rec in rdr.records() {
-            let rec = rec.map_err(|e| err("CSV".into(), e.to_string()))?;
+            let rec = rec.map_err(|e| {
+                let at = e
+                    .position()
+                    .map_or("CSV".to_string(), |p| format!("line {}", p.line()));
+                err(at, crate::rtest::layout::csv_message(&e))
+            })?;
             let line = rec.position().map_or(0, |p| p.line());
             let at = || format!("line {line}");
             let field = |i: usize| rec.get(i).unwrap_or("");

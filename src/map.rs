@@ -257,7 +257,7 @@ pub fn read_csv(path: &std::path::Path) -> Result<(MapSpec, Vec<MapPoint>), MapE
     let mut reader = csv::ReaderBuilder::new().from_reader(text.as_bytes());
     let header: Vec<String> = reader
         .headers()
-        .map_err(|e| bad(1, e.to_string()))?
+        .map_err(|e| bad(1, crate::rtest::layout::csv_message(&e)))?
         .iter()
         .map(str::to_string)
         .collect();
@@ -284,11 +284,29 @@ pub fn read_csv(path: &std::path::Path) -> Result<(MapSpec, Vec<MapPoint>), MapE
         .map(|h| h.strip_suffix("_um_s2_per_m").unwrap_or(h).parse::<Eij>())
         .collect::<Result<_, _>>()
         .map_err(|m| bad(1, m))?;
+    if let Some((k, p)) = params
+        .iter()
+        .enumerate()
+        .find(|(k, p)| params[..*k].contains(p))
+    {
+        return Err(bad(
+            1,
+            format!("column {}: {p} given twice", header[fixed.len() + k]),
+        ));
+    }
     let mut spec: Option<MapSpec> = None;
-    let mut points = Vec::new();
+    let mut points: Vec<MapPoint> = Vec::new();
+    // Grid positions as read, with their line: a point given twice would silently weigh twice.
+    let mut seen: BTreeMap<[u64; 3], usize> = BTreeMap::new();
     for (i, rec) in reader.records().enumerate() {
         let line = i + 2;
-        let rec = rec.map_err(|e| bad(line, e.to_string()))?;
+        if points.len() >= MAX_POINTS {
+            return Err(bad(line, format!("more than {MAX_POINTS} points")));
+        }
+        let rec = rec.map_err(|e| {
+            let at = e.position().map_or(line, |p| p.line() as usize);
+            bad(at, crate::rtest::layout::csv_message(&e))
+        })?;
         let num = |k: usize| -> Result<f64, MapError> {
             rec.get(k)
                 .and_then(|v| v.trim().parse::<f64>().ok())
@@ -311,8 +329,18 @@ pub fn read_csv(path: &std::path::Path) -> Result<(MapSpec, Vec<MapPoint>), MapE
         for (k, p) in params.iter().enumerate() {
             eij.insert(*p, num(fixed.len() + k)?);
         }
+        let position_mm = [num(0)?, num(1)?, num(2)?];
+        if let Some(first) = seen.insert(position_mm.map(f64::to_bits), line) {
+            return Err(bad(
+                line,
+                format!(
+                    "position {} mm given twice (first on line {first})",
+                    crate::text::nums(&position_mm)
+                ),
+            ));
+        }
         points.push(MapPoint {
-            position_m: vec![num(0)? * 1e-3, num(1)? * 1e-3, num(2)? * 1e-3],
+            position_m: position_mm.iter().map(|v| v * 1e-3).collect(),
             eij,
         });
     }

@@ -389,7 +389,7 @@ fn run_test(
             let mut circle = Circle::new(test.plane, radius_m, test.accel_m_s2, test.direction);
             circle.steady_revolutions = settings.revolutions;
             let run = simulate_discrete(cl, disc, &circle)?;
-            let series = output::to_series(cl, &run, test.label())?;
+            let series = output::to_series(cl, &run, "simulated series".into())?;
             let opts = EvalOptions {
                 plane: Some(test.plane),
                 radius_mm: Some(test.radius_mm),

@@ -33,6 +33,7 @@ pub struct CompensationArgs {
 
 /// Runs `eij compensation`.
 pub fn run(args: CompensationArgs) -> anyhow::Result<()> {
+    super::machine_args::accel_m_s2(args.accel_m_s2)?;
     let machine = Machine::from_file(&args.machine)?;
     eij::io::check_outputs(&[args.out.as_path()], &[args.machine.as_path()])?;
     let spec = TableSpec {

@@ -77,3 +77,21 @@ pub fn write_outputs(
     eij::io::write_set(files, inputs)?;
     Ok(())
 }
+
+/// `--accel-m-s2`: positive, and within what circle tests and moves use.
+pub fn accel_m_s2(v: f64) -> anyhow::Result<f64> {
+    let (lo, hi) = eij::rtest::checks::PLAUSIBLE_ACCEL_M_S2;
+    if !(v.is_finite() && v > 0.0) {
+        anyhow::bail!(
+            "--accel-m-s2: {} must be a positive number",
+            eij::text::num(v)
+        );
+    }
+    if !(lo..=hi).contains(&v) {
+        anyhow::bail!(
+            "--accel-m-s2: {} m/s² is outside what circle tests and moves use ({lo}–{hi} m/s²)",
+            eij::text::num(v)
+        );
+    }
+    Ok(v)
+}

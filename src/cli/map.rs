@@ -50,12 +50,7 @@ pub fn run(args: MapArgs) -> anyhow::Result<()> {
             args.radius_mm
         );
     }
-    if !(args.accel_m_s2.is_finite() && args.accel_m_s2 > 0.0) {
-        bail!(
-            "--accel-m-s2: {} must be a positive number",
-            args.accel_m_s2
-        );
-    }
+    super::machine_args::accel_m_s2(args.accel_m_s2)?;
     let machine = Machine::from_file(&args.machine)?;
     let outputs: Vec<&std::path::Path> = std::iter::once(args.out.as_path())
         .chain(args.plot.as_deref())

@@ -154,6 +154,9 @@ struct MoveArgs {
     jerk_m_s3: f64,
 }
 
+/// Most steady revolutions of a simulated circle.
+const MAX_REVOLUTIONS: u32 = 1000;
+
 /// Most samples one simulation writes: bounds memory and file size (100 s at 10 kHz).
 const MAX_SAMPLES: f64 = 1e6;
 
@@ -219,9 +222,12 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
             if radius_mm > 3.0 {
                 bail!("--radius-mm: {radius_mm} mm exceeds the R-Test probe range of ±3 mm");
             }
-            let accel = positive("accel-m-s2", c.accel_m_s2)?;
-            if c.revolutions == 0 {
-                bail!("--revolutions: at least one steady revolution is needed");
+            let accel = super::machine_args::accel_m_s2(c.accel_m_s2)?;
+            if !(1..=MAX_REVOLUTIONS).contains(&c.revolutions) {
+                bail!(
+                    "--revolutions: {} must lie in 1…{MAX_REVOLUTIONS} steady revolutions",
+                    c.revolutions
+                );
             }
             let mut circle = Circle::new(c.plane, radius_mm * 1e-3, accel, c.direction);
             circle.steady_revolutions = c.revolutions;
@@ -233,7 +239,7 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
                 bail!("--distance-mm: {} must be a non-zero number", m.distance_mm);
             }
             let v = positive("feed-mm-min", m.feed_mm_min)? / 60_000.0;
-            let a = positive("accel-m-s2", m.accel_m_s2)?;
+            let a = super::machine_args::accel_m_s2(m.accel_m_s2)?;
             let j = positive("jerk-m-s3", m.jerk_m_s3)?;
             let mv = JerkLimitedMove::new(m.axis, m.distance_mm * 1e-3, v, a, j);
             check_samples(&m.common, &mv, None)?;

@@ -66,7 +66,7 @@ impl IdentConfig {
         let from = self.source.clone().unwrap_or_else(|| "command line".into());
         let bad = |k: &str, v: String| IdentError::Test {
             input: from.clone(),
-            message: format!("{k} = {v} is not allowed"),
+            message: format!("{k} = {v}"),
         };
         let range = |k: &str, v: f64, lo: f64, hi: f64, unit: &str| {
             if v.is_finite() && v > lo && v <= hi {
@@ -74,14 +74,22 @@ impl IdentConfig {
             } else {
                 Err(bad(
                     k,
-                    format!("{}: must lie in ({}, {}]{unit}", num(v), num(lo), num(hi)),
+                    format!(
+                        "{} is not allowed: must lie in ({}, {}]{unit}",
+                        num(v),
+                        num(lo),
+                        num(hi)
+                    ),
                 ))
             }
         };
         let whole = |k: &str, v: f64, hi: f64| {
             let v = range(k, v, 0.0, hi, "")?;
             if v.fract() != 0.0 {
-                return Err(bad(k, format!("{}: must be a whole number", num(v))));
+                return Err(bad(
+                    k,
+                    format!("{} is not allowed: must be a whole number", num(v)),
+                ));
             }
             Ok(v)
         };
@@ -155,7 +163,7 @@ impl IdentConfig {
                 return Err(bad(
                     "position_mm",
                     format!(
-                        "{}: give one finite position per machine axis (at most 3, within ±1e5 mm)",
+                        "{} is not allowed: give one finite position per machine axis (at most 3, within ±1e5 mm)",
                         crate::text::nums(p)
                     ),
                 ));
@@ -166,7 +174,7 @@ impl IdentConfig {
             return Err(bad(
                 "min_factor",
                 format!(
-                    "{} (not below max_factor {})",
+                    "{} is not allowed: must lie below max_factor {}",
                     num(s.min_factor),
                     num(s.max_factor)
                 ),

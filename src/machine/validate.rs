@@ -10,6 +10,15 @@ use super::{
 use crate::axes::Axis;
 use nalgebra::{Matrix3, Vector3};
 
+/// Most bodies of a machine (each adds six degrees of freedom).
+pub const MAX_BODIES: usize = 100;
+/// Most joints between bodies.
+pub const MAX_JOINTS: usize = 1000;
+/// Most carriages over all guideways.
+pub const MAX_CARRIAGES: usize = 1000;
+/// Most extra catalogue files.
+pub const MAX_CATALOGUES: usize = 16;
+
 /// How far a given `workpiece.point_m` may lie from the TCP at the reference position, m.
 const NEST_TOLERANCE_M: f64 = 1e-6;
 
@@ -25,8 +34,37 @@ impl Machine {
         file: &str,
     ) -> Result<Self, MachineError> {
         let err = |key: String, msg: String| MachineError::new(file, key, msg);
-        non_negative(raw.rayleigh_beta_s, "rayleigh_beta_s".into(), Max(1.0, "s"))
-            .map_err(|(k, m)| err(k, m))?;
+        // Counts first: the model's matrices grow with the square of the bodies.
+        let carriages = raw
+            .axes
+            .iter()
+            .flat_map(|a| &a.guideway.rails)
+            .map(|r| r.carriages_m.len())
+            .sum::<usize>();
+        for (key, n, max) in [
+            ("body", raw.bodies.len(), MAX_BODIES),
+            ("axis", raw.axes.len(), 3),
+            ("joint", raw.joints.len(), MAX_JOINTS),
+            ("catalogue", raw.catalogue.len(), MAX_CATALOGUES),
+            (
+                "axis[].guideway.rail[].carriages_m",
+                carriages,
+                MAX_CARRIAGES,
+            ),
+        ] {
+            if n > max {
+                return Err(err(
+                    key.into(),
+                    format!("{n} given, at most {max} (a machine tool model has far fewer)"),
+                ));
+            }
+        }
+        non_negative(
+            raw.rayleigh_beta_s,
+            "rayleigh_beta_s".into(),
+            Range(0.0, 1.0, "s"),
+        )
+        .map_err(|(k, m)| err(k, m))?;
         let mut bodies = Vec::with_capacity(raw.bodies.len());
         for (i, b) in raw.bodies.iter().enumerate() {
             let key = |k: &str| format!("body[{}].{k}", b.name);
@@ -51,7 +89,7 @@ impl Machine {
             let mass = b
                 .mass_kg
                 .ok_or_else(|| err(key("mass_kg"), "missing (free bodies need a mass)".into()))?;
-            positive(mass, key("mass_kg"), Max(1e6, "kg")).map_err(|(k, m)| err(k, m))?;
+            positive(mass, key("mass_kg"), Range(1e-3, 1e6, "kg")).map_err(|(k, m)| err(k, m))?;
             if b.cog_m.is_none() {
                 return Err(err(
                     key("cog_m"),
@@ -241,7 +279,7 @@ impl Machine {
             coords(&j.point_m).map_err(|m| err(key("point_m"), m))?;
             for (k, v, max) in [
                 ("stiffness_n_per_m", j.stiffness_n_per_m, 1e13),
-                ("damping_n_s_per_m", j.damping_n_s_per_m, DAMPING.0),
+                ("damping_n_s_per_m", j.damping_n_s_per_m, DAMPING.1),
             ] {
                 if !v.iter().all(|x| x.is_finite() && *x >= 0.0) {
                     return Err(err(
@@ -300,6 +338,12 @@ fn check_inertia(j: &Matrix3<f64>) -> Result<(), String> {
             principal[0], principal[1], principal[2]
         ));
     }
+    if principal.min() < 1e-8 {
+        return Err(format!(
+            "principal moment {} kg·m² is below 1e-8 kg·m², less than any machine tool part has (a typo or a unit slip?)",
+            crate::text::num(principal.min())
+        ));
+    }
     if principal.max() > 1e7 {
         return Err(format!(
             "principal moment {} kg·m² is beyond 1e7 kg·m², more than any machine tool has (a typo or a unit slip?)",
@@ -318,42 +362,54 @@ fn check_inertia(j: &Matrix3<f64>) -> Result<(), String> {
 
 type FieldError = (String, String);
 
-/// Largest value of a quantity in any machine tool, with its unit: beyond it a value is a typo
-/// or a unit slip, and is named as such before it can surface as a numerical failure.
+/// The range of a quantity in any machine tool, smallest positive and largest value, with its
+/// unit: outside it a value is a typo or a unit slip, and is named as such before it can
+/// surface as a numerical failure (a singular model, NaN frequencies, an unstable loop).
 #[derive(Clone, Copy)]
-struct Max(f64, &'static str);
+struct Range(f64, f64, &'static str);
 
-const COORD: Max = Max(100.0, "m");
-const STIFFNESS_N_PER_UM: Max = Max(1e5, "N/µm");
-const FACTOR: Max = Max(100.0, "(times the file value)");
-const DAMPING: Max = Max(1e9, "N·s/m");
-const LENGTH: Max = Max(10.0, "m");
+const COORD: Range = Range(0.0, 100.0, "m");
+const STIFFNESS_N_PER_UM: Range = Range(1e-3, 1e5, "N/µm");
+const FACTOR: Range = Range(1e-4, 100.0, "(times the file value)");
+const DAMPING: Range = Range(0.0, 1e9, "N·s/m");
+const LENGTH: Range = Range(1e-3, 10.0, "m");
 
-fn in_range(v: f64, key: String, positive: bool, max: Max) -> Result<f64, FieldError> {
+fn in_range(v: f64, key: String, positive: bool, range: Range) -> Result<f64, FieldError> {
     let v_text = crate::text::num(v);
     if !(v.is_finite() && (v > 0.0 || (!positive && v == 0.0))) {
         let rel = if positive { ">" } else { "≥" };
         return Err((key, format!("{v_text} must be {rel} 0")));
     }
-    if v > max.0 {
+    let slip = "(a typo or a unit slip?)";
+    if v > range.1 {
         return Err((
             key,
             format!(
-                "{v_text} is beyond {} {}, more than any machine tool has (a typo or a unit slip?)",
-                crate::text::num(max.0),
-                max.1
+                "{v_text} is beyond {} {}, more than any machine tool has {slip}",
+                crate::text::num(range.1),
+                range.2
+            ),
+        ));
+    }
+    if v > 0.0 && v < range.0 {
+        return Err((
+            key,
+            format!(
+                "{v_text} is below {} {}, less than any machine tool has {slip}",
+                crate::text::num(range.0),
+                range.2
             ),
         ));
     }
     Ok(v)
 }
 
-fn positive(v: f64, key: String, max: Max) -> Result<f64, FieldError> {
-    in_range(v, key, true, max)
+fn positive(v: f64, key: String, range: Range) -> Result<f64, FieldError> {
+    in_range(v, key, true, range)
 }
 
-fn non_negative(v: f64, key: String, max: Max) -> Result<f64, FieldError> {
-    in_range(v, key, false, max)
+fn non_negative(v: f64, key: String, range: Range) -> Result<f64, FieldError> {
+    in_range(v, key, false, range)
 }
 
 /// Every coordinate finite and within [`COORD`].
@@ -361,11 +417,11 @@ fn coords(p: &[f64]) -> Result<(), String> {
     if !p.iter().all(|x| x.is_finite()) {
         return Err("must be finite".into());
     }
-    if p.iter().any(|x| x.abs() > COORD.0) {
+    if p.iter().any(|x| x.abs() > COORD.1) {
         return Err(format!(
             "{} m lies beyond ±{} m, farther than any machine tool reaches (mm given as m?)",
             crate::text::nums(p),
-            COORD.0
+            COORD.1
         ));
     }
     Ok(())
@@ -468,14 +524,22 @@ fn validate_drive(d: &raw::RawDrive, key: &dyn Fn(&str) -> String) -> Result<Dri
     ] {
         coords(&p).map_err(|m| (key(k), m))?;
     }
-    let diameter = positive(d.screw_diameter_m, key("screw_diameter_m"), Max(1.0, "m"))?;
+    let diameter = positive(
+        d.screw_diameter_m,
+        key("screw_diameter_m"),
+        Range(1e-3, 1.0, "m"),
+    )?;
     let drive = Drive {
         nut_m: Vector3::from(d.nut_m),
         bearing_m: Vector3::from(d.bearing_m),
         scale_m: Vector3::from(d.scale_m),
-        lead_m: positive(d.lead_m, key("lead_m"), Max(1.0, "m"))?,
+        lead_m: positive(d.lead_m, key("lead_m"), Range(1e-4, 1.0, "m"))?,
         screw_area_m2: std::f64::consts::PI * diameter * diameter / 4.0,
-        screw_modulus_pa: positive(d.screw_modulus_pa, key("screw_modulus_pa"), Max(1e13, "Pa"))?,
+        screw_modulus_pa: positive(
+            d.screw_modulus_pa,
+            key("screw_modulus_pa"),
+            Range(1e9, 1e13, "Pa"),
+        )?,
         support: d.support,
         screw_length_m: match (d.support, d.screw_length_m) {
             (Support::FixedFixed, Some(l)) => Some(positive(l, key("screw_length_m"), LENGTH)?),
@@ -505,12 +569,12 @@ fn validate_drive(d: &raw::RawDrive, key: &dyn Fn(&str) -> String) -> Result<Dri
         rotor_inertia_kg_m2: positive(
             d.rotor_inertia_kg_m2,
             key("rotor_inertia_kg_m2"),
-            Max(100.0, "kg·m²"),
+            Range(1e-8, 100.0, "kg·m²"),
         )?,
         friction_nm_s_per_rad: non_negative(
             d.friction_nm_s_per_rad,
             key("friction_nm_s_per_rad"),
-            Max(1e6, "N·m·s/rad"),
+            Range(0.0, 1e6, "N·m·s/rad"),
         )?,
     };
     Ok(drive)
@@ -542,29 +606,29 @@ fn validate_control(
     key: &dyn Fn(&str) -> String,
 ) -> Result<Control, FieldError> {
     Ok(Control {
-        kv_per_s: positive(c.kv_per_s, key("kv_per_s"), Max(1e4, "1/s"))?,
+        kv_per_s: positive(c.kv_per_s, key("kv_per_s"), Range(0.1, 1e4, "1/s"))?,
         kp_nm_s_per_rad: positive(
             c.kp_nm_s_per_rad,
             key("kp_nm_s_per_rad"),
-            Max(1e6, "N·m·s/rad"),
+            Range(1e-6, 1e6, "N·m·s/rad"),
         )?,
-        tn_s: positive(c.tn_s, key("tn_s"), Max(100.0, "s"))?,
-        current_lag_s: non_negative(c.current_lag_s, key("current_lag_s"), Max(0.1, "s"))?,
+        tn_s: positive(c.tn_s, key("tn_s"), Range(1e-5, 100.0, "s"))?,
+        current_lag_s: non_negative(c.current_lag_s, key("current_lag_s"), Range(0.0, 0.1, "s"))?,
         setpoint_filter_s: non_negative(
             c.setpoint_filter_s,
             key("setpoint_filter_s"),
-            Max(10.0, "s"),
+            Range(0.0, 10.0, "s"),
         )?,
         feedback: c.feedback,
         velocity_feedforward: non_negative(
             c.velocity_feedforward,
             key("velocity_feedforward"),
-            Max(2.0, ""),
+            Range(0.0, 2.0, ""),
         )?,
         acceleration_feedforward: non_negative(
             c.acceleration_feedforward,
             key("acceleration_feedforward"),
-            Max(2.0, ""),
+            Range(0.0, 2.0, ""),
         )?,
     })
 }

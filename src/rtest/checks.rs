@@ -52,10 +52,28 @@ pub(super) fn check_units(
     let r0 = 0.5 * (amp_int[a.index()] + amp_int[b.index()]);
     let column = INT_COLUMNS[a.index()].to_string();
     if r0 > MAX_PLAUSIBLE_RADIUS_MM {
+        let detail = format!(
+            "circle radius {} is implausible for an R-Test circle",
+            crate::text::num(if r0 < 1e6 {
+                (r0 * 10.0).round() / 10.0
+            } else {
+                r0
+            })
+        );
+        // Only where the values read as µm make a plausible circle is µm the likely slip.
+        if r0 * 1e-3 > MAX_PLAUSIBLE_RADIUS_MM {
+            return Err(RtestError::Implausible {
+                at: whole(),
+                column,
+                detail: format!(
+                    "{detail} (at most {MAX_PLAUSIBLE_RADIUS_MM} mm, and too large for µm as well)"
+                ),
+            });
+        }
         return Err(RtestError::LooksLikeMicrometres {
             at: whole(),
             column,
-            detail: format!("circle radius {r0:.1} is implausible for an R-Test circle"),
+            detail,
         });
     }
     if let Some(set) = set_radius_mm {
@@ -71,7 +89,7 @@ pub(super) fn check_units(
 }
 
 /// Plausible set accelerations of an R-Test circle, m/s² (outside: wrong units of time).
-const PLAUSIBLE_ACCEL_M_S2: (f64, f64) = (0.01, 1000.0);
+pub const PLAUSIBLE_ACCEL_M_S2: (f64, f64) = (0.01, 1000.0);
 /// Plausible circle frequencies, Hz.
 const PLAUSIBLE_FREQ_HZ: (f64, f64) = (0.01, 500.0);
 

@@ -172,6 +172,16 @@ impl TestConditions {
             columns.overridden_by(&map(&raw.internal_columns, "internal_columns")?);
         let external_columns =
             columns.overridden_by(&map(&raw.external_columns, "external_columns")?);
+        if raw.test.len() > super::inputs::MAX_TESTS {
+            return Err(bad(
+                "[[test]]",
+                format!(
+                    "{} entries, at most {}",
+                    raw.test.len(),
+                    super::inputs::MAX_TESTS
+                ),
+            ));
+        }
         let mut tests = Vec::new();
         for (i, t) in raw.test.into_iter().enumerate() {
             tests.push(test_entry(i + 1, t, &bad)?);
@@ -194,9 +204,10 @@ fn check_radius(
     bad: &dyn Fn(&str, String) -> RtestError,
 ) -> Result<(), RtestError> {
     match r {
-        Some(r) if !(r.is_finite() && r > 0.0 && r <= 3.0) => {
-            Err(bad(key, format!("{r} must lie in (0, 3] mm")))
-        }
+        Some(r) if !(r.is_finite() && r > 0.0 && r <= 3.0) => Err(bad(
+            key,
+            format!("{} must lie in (0, 3] mm", crate::text::num(r)),
+        )),
         _ => Ok(()),
     }
 }
@@ -211,6 +222,13 @@ fn check_position(
             Err(bad(key, "values must be finite".into()))
         }
         Some([]) => Err(bad(key, "empty; give one position per machine axis".into())),
+        Some(p) if p.len() > 3 || p.iter().any(|v| v.abs() > 1e5) => Err(bad(
+            key,
+            format!(
+                "{} mm: give one position per machine axis (at most 3, within ±1e5 mm)",
+                crate::text::nums(p)
+            ),
+        )),
         _ => Ok(()),
     }
 }
@@ -273,13 +291,16 @@ fn test_entry(
         if !(f.is_finite() && f > 0.0) {
             return Err(bad(
                 &key("feed_mm_min"),
-                format!("{f} must be a positive feed"),
+                format!("{} must be a positive feed", crate::text::num(f)),
             ));
         }
     }
     if let Some(o) = t.time_offset_ms {
-        if !o.is_finite() {
-            return Err(bad(&key("time_offset_ms"), format!("{o} must be finite")));
+        if !(o.is_finite() && o.abs() <= 3.6e6) {
+            return Err(bad(
+                &key("time_offset_ms"),
+                format!("{} must be finite, within an hour", crate::text::num(o)),
+            ));
         }
     }
     Ok(TestEntry {

@@ -190,6 +190,26 @@ impl ColumnMap {
                 },
             );
         }
+        // One file column feeds one contract column: two would read the same numbers twice
+        // (an unmapped contract column keeps its own name).
+        let effective = |c: &str| specs.get(c).map_or(c.to_string(), |s| s.name.clone());
+        for (i, c) in CONTRACT_COLUMNS.iter().enumerate() {
+            let name = effective(c);
+            if let Some(other) = CONTRACT_COLUMNS[..i]
+                .iter()
+                .find(|o| effective(o).eq_ignore_ascii_case(&name))
+            {
+                let key = if specs.contains_key(*c) { c } else { other };
+                return Err(RtestError::Conditions {
+                    file: file.to_string(),
+                    key: format!("{table}.{key}.name"),
+                    message: format!(
+                        "'{}' is the file column of both {other} and {c}; each contract column needs its own",
+                        quote_cell(&name)
+                    ),
+                });
+            }
+        }
         Ok(ColumnMap { specs })
     }
 
@@ -520,19 +540,26 @@ impl<'a> LineCounter<'a> {
 /// Turns a CSV reader error into a one-line error naming the line.
 pub(crate) fn csv_error(source: &str, lines: &mut LineCounter, e: csv::Error) -> RtestError {
     let line = e.position().map(|p| lines.line_of_position(p));
-    let message = match e.kind() {
-        csv::ErrorKind::UnequalLengths {
-            expected_len, len, ..
-        } => format!("{len} field(s), the header has {expected_len}"),
-        csv::ErrorKind::Utf8 { .. } => "not valid UTF-8 text".to_string(),
-        _ => e.to_string(),
-    };
+    let message = csv_message(&e);
     RtestError::Csv {
         at: Location {
             source: source.to_string(),
             line: line.map(Line::File),
         },
         message,
+    }
+}
+
+/// What a CSV reader's error says, without its own position (the caller names file and line:
+/// the reader's "CSV error: record 2 (line: 3, byte: 120)" would repeat them).
+pub(crate) fn csv_message(e: &csv::Error) -> String {
+    match e.kind() {
+        csv::ErrorKind::UnequalLengths {
+            expected_len, len, ..
+        } => format!("{len} field(s), the header has {expected_len}"),
+        csv::ErrorKind::Utf8 { .. } => "not valid UTF-8 text".to_string(),
+        csv::ErrorKind::Io(io) => io.to_string(),
+        _ => e.to_string(),
     }
 }
 

@@ -10,6 +10,7 @@ use super::layout::{csv_error, parse_decimal, LineCounter};
 use super::series::{column_indices, read_bounded, require_columns};
 use super::CircleResult;
 use crate::axes::{Direction, Eij, Plane};
+use crate::text::num;
 
 /// Whether a file looks like an EIJ table (its header has a `parameter` column) rather than a
 /// time series.
@@ -38,6 +39,9 @@ pub fn looks_like_table(path: &Path) -> bool {
         })
         .unwrap_or(false)
 }
+
+/// Largest |EIJ| or standard error a table may give, µm·s²/m.
+pub const MAX_EIJ: f64 = 1e6;
 
 /// Required columns, in the order written.
 pub const COLUMNS: [&str; 5] = [
@@ -163,7 +167,17 @@ pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<Vec<EijRow>, RtestError> {
         if accel_m_s2 <= 0.0 {
             return Err(bad(
                 2,
-                format!("acceleration {accel_m_s2} must be positive"),
+                format!("acceleration {} must be positive", num(accel_m_s2)),
+            ));
+        }
+        // The range of circle tests (the evaluation's plausibility check of a series).
+        if !(0.01..=1000.0).contains(&accel_m_s2) {
+            return Err(bad(
+                2,
+                format!(
+                    "acceleration {} m/s² is implausible for a circle test (expected 0.01–1000)",
+                    num(accel_m_s2)
+                ),
             ));
         }
         let parameter: Eij = cell(3).parse().map_err(|m| bad(3, m))?;
@@ -174,19 +188,33 @@ pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<Vec<EijRow>, RtestError> {
             ));
         }
         let value = number(raw(4), line, COLUMNS[4])?;
+        // 1e6 µm·s²/m is 1 m of deviation per m/s²: beyond it a value is a unit slip.
+        if value.abs() > MAX_EIJ {
+            return Err(bad(
+                4,
+                format!(
+                    "{} µm·s²/m is implausible for an EIJ (at most ±{}; units?)",
+                    num(value),
+                    num(MAX_EIJ)
+                ),
+            ));
+        }
         let std_err = match index[5] {
             usize::MAX => None,
             i => match record.get(i).unwrap_or("") {
                 "" => None,
                 text => {
                     let s = number(text, line, STD_ERR_COLUMN)?;
-                    if s <= 0.0 {
+                    if s <= 0.0 || s > MAX_EIJ {
                         return Err(RtestError::BadValue {
                             at: at(),
                             column: STD_ERR_COLUMN.into(),
                             message: format!(
-                                "standard error {s} must be positive (a zero would give the \
-                                 value infinite weight; leave the cell empty when unknown)"
+                                "standard error {} must be positive (a zero would give the \
+                                 value infinite weight; leave the cell empty when unknown) and \
+                                 at most {}",
+                                num(s),
+                                num(MAX_EIJ)
                             ),
                         });
                     }
@@ -199,8 +227,9 @@ pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<Vec<EijRow>, RtestError> {
             return Err(bad(
                 3,
                 format!(
-                    "{parameter} of {plane} {direction} at {accel_m_s2} m/s² given twice \
-                     (first on line {first})"
+                    "{parameter} of {plane} {direction} at {} m/s² given twice \
+                     (first on line {first})",
+                    num(accel_m_s2)
                 ),
             ));
         }

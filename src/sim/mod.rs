@@ -150,8 +150,8 @@ fn run_piecewise(pieces: &[Piece], setpoint: &dyn SetPoint) -> Result<Run, SimEr
     let steps = (setpoint.duration_s() / h).ceil();
     if !(steps.is_finite() && steps < MAX_SAMPLES as f64) {
         return Err(SimError::Invalid(format!(
-            "{} s at {} Hz would be {} samples, at most {MAX_SAMPLES} are simulated",
-            crate::text::num(setpoint.duration_s()),
+            "{:.4} s at {} Hz would be {} samples, at most {MAX_SAMPLES} are simulated (a lower rate or fewer revolutions)",
+            setpoint.duration_s(),
             crate::text::num(1.0 / h),
             crate::text::num(steps)
         )));
