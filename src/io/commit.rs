@@ -334,3 +334,106 @@ mod signals {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A process id that runs nowhere (above any pid_max).
+    const DEAD: u32 = i32::MAX as u32;
+
+    fn scratch(tag: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("eij-commit-{tag}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(d.join("b")).unwrap();
+        d.canonicalize().unwrap()
+    }
+
+    fn names(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
+
+    /// What a commit killed after writing its temporary files and `copies` of its journal
+    /// leaves behind, for outputs `x` in `dir` and `y` in `dir/b`.
+    fn killed_commit(dir: &Path, copies: usize) {
+        let staged = [
+            (dir.join(format!(".eij-{DEAD}-1.tmp")), dir.join("x")),
+            (dir.join(format!("b/.eij-{DEAD}-2.tmp")), dir.join("b/y")),
+        ];
+        for (tmp, _) in &staged {
+            std::fs::write(tmp, "new").unwrap();
+        }
+        let journals = [
+            dir.join(format!(".eij-{DEAD}-3.commit")),
+            dir.join(format!("b/.eij-{DEAD}-4.commit")),
+        ];
+        let text = serde_json::to_vec(&Journal {
+            renames: staged.to_vec(),
+            copies: journals.to_vec(),
+        })
+        .unwrap();
+        for j in &journals[..copies] {
+            std::fs::write(j, &text).unwrap();
+        }
+    }
+
+    #[test]
+    fn a_journal_written_in_full_is_completed_from_either_folder() {
+        for from_b in [false, true] {
+            let dir = scratch(&format!("full-{from_b}"));
+            std::fs::write(dir.join("x"), "old").unwrap();
+            std::fs::write(dir.join("b/y"), "old").unwrap();
+            killed_commit(&dir, 2);
+            // The kill fell after the first rename.
+            std::fs::rename(dir.join(format!(".eij-{DEAD}-1.tmp")), dir.join("x")).unwrap();
+            recover(&if from_b { dir.join("b") } else { dir.clone() });
+            assert_eq!(std::fs::read_to_string(dir.join("x")).unwrap(), "new");
+            assert_eq!(std::fs::read_to_string(dir.join("b/y")).unwrap(), "new");
+            assert_eq!(names(&dir), ["b", "x"]);
+            assert_eq!(names(&dir.join("b")), ["y"]);
+            std::fs::remove_dir_all(&dir).unwrap();
+        }
+    }
+
+    #[test]
+    fn a_journal_cut_short_leaves_the_old_set() {
+        let dir = scratch("cut");
+        std::fs::write(dir.join("x"), "old").unwrap();
+        std::fs::write(dir.join("b/y"), "old").unwrap();
+        killed_commit(&dir, 1);
+        recover(&dir);
+        recover(&dir.join("b"));
+        assert_eq!(std::fs::read_to_string(dir.join("x")).unwrap(), "old");
+        assert_eq!(std::fs::read_to_string(dir.join("b/y")).unwrap(), "old");
+        assert_eq!(names(&dir), ["b", "x"]);
+        assert_eq!(names(&dir.join("b")), ["y"]);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_set_replaces_every_file_or_none() {
+        let dir = scratch("set");
+        let (x, y) = (dir.join("x"), dir.join("b/y"));
+        write_set(&[(&x, b"1"), (&y, b"1")], &[]).unwrap();
+        write_set(&[(&x, b"2"), (&y, b"2")], &[]).unwrap();
+        assert_eq!(std::fs::read(&x).unwrap(), b"2");
+        // One output an input: neither is written.
+        let err = write_set(&[(&x, b"3"), (&y, b"3")], &[y.as_path()]).unwrap_err();
+        assert!(matches!(err, WriteError::WouldClobberInput { .. }), "{err}");
+        let err = write_set(&[(&x, b"3"), (&dir.join("./x"), b"3")], &[]).unwrap_err();
+        assert!(matches!(err, WriteError::SameOutput { .. }), "{err}");
+        let err = write_set(&[(&x, b"3"), (&dir.join("no/y"), b"3")], &[]).unwrap_err();
+        assert!(matches!(err, WriteError::NoFolder { .. }), "{err}");
+        let err = write_set(&[(&x, b"3"), (&dir.join("b"), b"3")], &[]).unwrap_err();
+        assert!(matches!(err, WriteError::IsAFolder { .. }), "{err}");
+        assert_eq!(std::fs::read(&x).unwrap(), b"2");
+        assert_eq!(std::fs::read(&y).unwrap(), b"2");
+        assert_eq!(names(&dir), ["b", "x"]);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

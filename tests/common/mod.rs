@@ -70,16 +70,23 @@ impl Scratch {
         p.display().to_string()
     }
 
-    /// Every entry below the folder (hidden temporary files included), with its contents.
+    /// Every entry below the folder (hidden temporary files included), with its contents (a
+    /// symbolic link: its target; a FIFO, device or socket: its kind, never read).
     pub fn snapshot(&self) -> BTreeSet<(PathBuf, Vec<u8>)> {
         fn walk(dir: &Path, out: &mut BTreeSet<(PathBuf, Vec<u8>)>) {
             for e in std::fs::read_dir(dir).unwrap() {
                 let p = e.unwrap().path();
-                if p.is_dir() {
+                let t = std::fs::symlink_metadata(&p).unwrap().file_type();
+                if t.is_symlink() {
+                    let target = std::fs::read_link(&p).unwrap();
+                    out.insert((p, format!("link {}", target.display()).into_bytes()));
+                } else if t.is_dir() {
                     out.insert((p.clone(), Vec::new()));
                     walk(&p, out);
-                } else {
+                } else if t.is_file() {
                     out.insert((p.clone(), std::fs::read(&p).unwrap()));
+                } else {
+                    out.insert((p, format!("special {t:?}").into_bytes()));
                 }
             }
         }
