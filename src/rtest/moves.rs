@@ -67,14 +67,15 @@ fn read(path: &Path, axis: Axis) -> Result<Record, MoveError> {
         at,
         message,
     };
+    let bytes = crate::io::read_input(path, crate::io::read::MAX_SERIES_BYTES)
+        .map_err(|e| err("file".into(), format!("cannot read: {e}")))?;
     let mut rdr = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .comment(Some(b'#'))
-        .from_path(path)
-        .map_err(|e| err("file".into(), format!("cannot read: {e}")))?;
+        .from_reader(bytes.as_slice());
     let header: Vec<String> = rdr
         .headers()
-        .map_err(|e| err("header".into(), e.to_string()))?
+        .map_err(|e| err("header".into(), super::layout::csv_message(&e)))?
         .iter()
         .map(str::to_string)
         .collect();
@@ -108,7 +109,12 @@ fn read(path: &Path, axis: Axis) -> Result<Record, MoveError> {
     };
     let mut raw_set: [Vec<f64>; 3] = Default::default();
     for r in rdr.records() {
-        let r = r.map_err(|e| err("CSV".into(), e.to_string()))?;
+        let r = r.map_err(|e| {
+            let at = e
+                .position()
+                .map_or("CSV".to_string(), |p| format!("line {}", p.line()));
+            err(at, super::layout::csv_message(&e))
+        })?;
         let line = r.position().map_or(0, |p| p.line());
         if rec.t.len() >= MAX_SAMPLES {
             return Err(err(
