@@ -6,14 +6,13 @@ mod common;
 use common::{root, Scratch};
 use std::process::{Command, Output};
 
-/// Runs identify on three ZX files with the Z guideway factors, plus `extra` arguments.
-fn identify(s: &Scratch, extra: &[&str]) -> Output {
+/// identify on three ZX files with the Z guideway factors, writing into `s`.
+fn identify_command(s: &Scratch) -> Command {
     let zx = |n: &str| root().join("measurements/demo-vmc").join(n);
-    Command::new(env!("CARGO_BIN_EXE_eij"))
-        .current_dir(root())
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_eij"));
+    cmd.current_dir(root())
         .args([
             "identify",
-            "--quiet",
             "--machine",
             "machines/demo-vmc.toml",
             "--measured",
@@ -30,7 +29,14 @@ fn identify(s: &Scratch, extra: &[&str]) -> Output {
         ])
         .arg(s.path("id.toml"))
         .arg("--report")
-        .arg(s.path("id.json"))
+        .arg(s.path("id.json"));
+    cmd
+}
+
+/// Runs [`identify_command`] with `--quiet` and `extra` arguments.
+fn identify(s: &Scratch, extra: &[&str]) -> Output {
+    identify_command(s)
+        .arg("--quiet")
         .args(extra)
         .output()
         .unwrap()
@@ -363,4 +369,78 @@ fn a_file_without_its_set_radius_says_which_radius_was_assumed() {
             && stderr.contains("mean internal radius is 1.9"),
         "{stderr}"
     );
+}
+
+/// The default output is a short verdict whose χ² line follows from the report's numbers;
+/// `--tables` adds one line per measured EIJ under a header that explains its columns.
+#[test]
+fn default_output_is_a_short_verdict_and_tables_come_on_request() {
+    let s = Scratch::new("print");
+    let run = |extra: &[&str]| {
+        let out = identify_command(&s)
+            .arg("--no-design")
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let short = run(&[]);
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(s.path("id.json")).unwrap()).unwrap();
+    assert!(short.lines().count() <= 30, "{short}");
+    // χ²: s² against 1 + 4·√(2/dof), dof = values − free parameters − static terms − clocks.
+    let statics: usize = json["static_terms"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|g| {
+            g["geometric_um_per_mm"].as_object().unwrap().len()
+                + g["reversal_um_per_mm"].as_object().unwrap().len()
+        })
+        .sum();
+    let clocks = json["clock_offsets"].as_array().unwrap().len();
+    let dof = json["residuals"].as_u64().unwrap() as usize - 2 - statics - clocks;
+    assert_eq!(json["degrees_of_freedom"].as_u64().unwrap() as usize, dof);
+    let s_fit = json["residual_std"].as_f64().unwrap();
+    let limit = (1.0 + 4.0 * (2.0 / dof as f64).sqrt()).sqrt();
+    let verdict = if s_fit <= limit { "passed" } else { "FAILED" };
+    let expected = format!("χ² test {verdict}: s = {s_fit:.3}");
+    assert!(short.contains(&expected), "'{expected}' not in {short}");
+    assert!(short.contains(&format!("over {dof} degrees of freedom")));
+    for p in json["parameters"].as_array().unwrap() {
+        let (v, se) = (
+            p["identified"].as_f64().unwrap(),
+            p["std_err"].as_f64().unwrap(),
+        );
+        let line = short
+            .lines()
+            .find(|l| l.trim_start().starts_with(p["name"].as_str().unwrap()))
+            .unwrap();
+        assert!(line.contains(&format!("{:.1} %", 100.0 * se / v)), "{line}");
+        let rel = se / v;
+        let word = match rel {
+            r if r <= 0.1 => "determined",
+            r if r <= 0.5 => "loose",
+            r if r <= 1.0 => "weak",
+            _ => "NOT determined",
+        };
+        assert!(line.ends_with(word), "{line}");
+    }
+    assert!(
+        !short.contains(" EZZ "),
+        "the per-EIJ table is not in the short output"
+    );
+
+    let long = run(&["--tables"]);
+    assert!(long.contains("'-' where the measured value is zero within 3σ"));
+    let rows = long
+        .lines()
+        .filter(|l| l.contains(" m/s² @ ") && l.contains(" ± "))
+        .count();
+    assert_eq!(rows as u64, json["residuals"].as_u64().unwrap(), "{long}");
 }

@@ -93,9 +93,14 @@ pub struct IdentifyArgs {
     /// test, cost over iterations) as SVG.
     #[arg(long, value_name = "FILE.svg")]
     plot: Option<PathBuf>,
-    /// No progress bar and no tables; warnings and errors still go to standard error.
+    /// No progress bar and nothing on standard output; warnings and errors still go to
+    /// standard error.
     #[arg(long)]
     quiet: bool,
+    /// Also print the full tables: every measured and simulated EIJ with their ratios, the
+    /// correlation matrix, every static term, clock offset and candidate test.
+    #[arg(long, visible_alias = "verbose", conflicts_with = "quiet")]
+    tables: bool,
 }
 
 /// `--method`: the library's [`Method`] as the command line spells it.
@@ -378,10 +383,17 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
     ident_report.validation = validation.as_ref().map(Into::into);
     ident_report.clocks = prep.clocks.iter().map(Into::into).collect();
     if !args.quiet {
-        super::identify_print::print_result(&prep.problem, &result, seconds);
-        super::identify_print::print_clocks(&prep.clocks);
+        let tables = args.tables;
+        super::identify_print::print_result(&prep.problem, &result, &ident_report, seconds, tables);
+        super::identify_print::print_clocks(&prep.clocks, tables);
         if let Some(v) = &validation {
-            super::identify_print::print_validation(v);
+            super::identify_print::print_validation(v, tables);
+        }
+        if !tables {
+            println!(
+                "\nfull tables (every EIJ measured and simulated, correlations, static terms, candidate tests, clocks): --tables;\n\
+                 all of it is in the report JSON, and `eij report --identify-report` shows it as a page"
+            );
         }
     }
     if let Some(refusal) = &result.refusal {

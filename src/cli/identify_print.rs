@@ -1,13 +1,51 @@
-//! What `eij identify` prints on standard output: parameters, correlations, tests, static
-//! terms, the ranking of candidate tests and the hold-out validation.
+//! What `eij identify` prints on standard output. By default a short verdict: the fit, the
+//! parameters with their standing, strong correlations, one line per plane and circle centre,
+//! and one line each for the static terms, the clock offsets and the best additional test.
+//! With `--tables` also the full tables: every measured and simulated EIJ, the correlation
+//! matrix, the static terms, every candidate test, every clock. Warnings go to standard error
+//! (printed by the caller), never only here.
 
 use eij::ident::design::Design;
+use eij::ident::report::IdentReport;
 use eij::ident::validation::Validation;
+use eij::ident::verdict::{implausible, Standing};
 use eij::ident::{IdentResult, Problem};
 use eij::rtest::pooled::geometric_name;
 
-/// The tables of an identification on standard output (warnings go to standard error).
-pub(super) fn print_result(p: &Problem, result: &IdentResult, seconds: f64) {
+/// Correlations at least this large in magnitude are listed in the short output.
+const STRONG_CORRELATION: f64 = 0.9;
+
+/// A value counts for the simulated/measured ratios when |measured| exceeds this many σ (a
+/// ratio to a value that is zero within its uncertainty means nothing).
+const RATIO_SIGMAS: f64 = 3.0;
+
+/// The identification on standard output: the verdict, and with `tables` the full tables.
+pub(super) fn print_result(
+    p: &Problem,
+    result: &IdentResult,
+    report: &IdentReport,
+    seconds: f64,
+    tables: bool,
+) {
+    print_verdict(p, result, report, seconds);
+    if tables {
+        print_correlation(result);
+        print_eij_table(p, result);
+    }
+    print_groups(p, result);
+    print_ratios(p, result);
+    print_statics(result, tables);
+    print_fitted_clocks(result, tables);
+    if let Some(d) = &result.design {
+        print_design(d, tables);
+    }
+    for n in &result.notes {
+        println!("note: {n}");
+    }
+}
+
+/// Status, fit quality, parameters with their standing, strong correlations, warnings.
+fn print_verdict(p: &Problem, result: &IdentResult, report: &IdentReport, seconds: f64) {
     let verb = if result.refusal.is_some() {
         "Fit REFUSED (nothing exported) for"
     } else {
@@ -22,48 +60,107 @@ pub(super) fn print_result(p: &Problem, result: &IdentResult, seconds: f64) {
         seconds
     );
     println!(
-        "cost Σr² {:.4e} -> {:.4e}   residual std s = {:.3}",
+        "cost Σr² {:.4e} -> {:.4e}   residual std s = {:.3}   (r = (simulated − measured EIJ) / σ)",
         result.cost_initial, result.cost_final, result.residual_std
     );
-    println!("\n  parameter              initial   identified    std err");
-    for q in &result.parameters {
+    if let Some(c) = report.chi2() {
+        println!("χ² test {}", c.describe());
+    }
+    println!("\n  parameter              initial   identified    std err   σ/value  standing");
+    for q in &report.parameters {
+        let standing = report.standing(q);
+        let rel = standing
+            .rel_std_err()
+            .map_or("-".to_string(), |r| format!("{:.1} %", 100.0 * r));
+        let plausible = if standing != Standing::NotIdentifiable && implausible(q.identified) {
+            ", implausible factor"
+        } else {
+            ""
+        };
         match q.std_err {
             Some(s) => println!(
-                "  {:<22} {:>7.4}   {:>10.4}   {:>8.4}",
-                q.name, q.initial, q.value, s
+                "  {:<22} {:>7.4}   {:>10.4}   {:>8.4}  {:>8}  {}{plausible}",
+                q.name,
+                q.initial,
+                q.identified,
+                s,
+                rel,
+                standing.label()
             ),
             None => println!(
-                "  {:<22} {:>7.4}   {:>10}   not identifiable",
-                q.name, q.initial, "-"
+                "  {:<22} {:>7.4}   {:>10.4}   {:>8}  {:>8}  {} (kept at its start value)",
+                q.name,
+                q.initial,
+                q.identified,
+                "-",
+                rel,
+                standing.label()
             ),
         }
     }
+    let legend = Standing::legend();
+    let (a, b) = legend.split_once("; ").unwrap_or((&legend, ""));
+    println!("  ({a};\n   {b})");
     let n = result.parameters.len();
-    if n > 1 {
-        println!("\n  correlation");
-        for i in 0..n {
-            let row: Vec<String> = (0..n)
-                .map(|k| format!("{:>6.2}", result.correlation[(i, k)]))
-                .collect();
-            println!("  {:<22} {}", result.parameters[i].name, row.join(" "));
-        }
+    let strong: Vec<String> = (0..n)
+        .flat_map(|i| (i + 1..n).map(move |k| (i, k)))
+        .filter(|&(i, k)| result.correlation[(i, k)].abs() >= STRONG_CORRELATION)
+        .map(|(i, k)| {
+            format!(
+                "{} / {} {:+.2}",
+                result.parameters[i].name,
+                result.parameters[k].name,
+                result.correlation[(i, k)]
+            )
+        })
+        .collect();
+    if !strong.is_empty() {
+        println!(
+            "  strongly correlated (|r| ≥ {STRONG_CORRELATION}): {}",
+            strong.join(", ")
+        );
     }
+    match result.warnings.len() {
+        0 => println!("\nwarnings: none"),
+        k => println!("\nwarnings: {k} (on standard error above; also in the report JSON)"),
+    }
+}
+
+/// The full correlation matrix.
+fn print_correlation(result: &IdentResult) {
+    let n = result.parameters.len();
+    if n < 2 {
+        return;
+    }
+    println!("\n  correlation of the identified parameters");
+    for i in 0..n {
+        let row: Vec<String> = (0..n)
+            .map(|k| format!("{:>6.2}", result.correlation[(i, k)]))
+            .collect();
+        println!("  {:<22} {}", result.parameters[i].name, row.join(" "));
+    }
+}
+
+/// Every measured EIJ beside its simulation before and after, with the ratios.
+fn print_eij_table(p: &Problem, result: &IdentResult) {
     println!(
-        "\n  {:<36} EIJ   measured ± σ       catalogue (ratio)   identified (ratio)   (µm·s²/m)",
+        "\n  every EIJ, µm·s²/m: measured ± σ (the test's evaluation and its standard error), simulated with the\n  \
+         catalogue (start) factors and with the identified ones; (ratio) = simulated / measured where |measured| > {RATIO_SIGMAS}σ,\n  \
+         '-' where the measured value is zero within {RATIO_SIGMAS}σ (a ratio to it means nothing)"
+    );
+    println!(
+        "  {:<36} EIJ   measured ± σ       catalogue (ratio)   identified (ratio)",
         "test"
     );
     for (i, t) in p.tests().iter().enumerate() {
         for (e, (m, s)) in &t.measured {
-            let a = result.simulated_initial[i]
-                .get(e)
-                .copied()
-                .unwrap_or(f64::NAN);
-            let b = result.simulated_final[i]
-                .get(e)
-                .copied()
-                .unwrap_or(f64::NAN);
+            let sim = |v: &eij::ident::EijMap| v.get(e).copied().unwrap_or(f64::NAN);
+            let (a, b) = (
+                sim(&result.simulated_initial[i]),
+                sim(&result.simulated_final[i]),
+            );
             let ratio = |x: f64| {
-                if m.abs() > 3.0 * s {
+                if m.abs() > RATIO_SIGMAS * s {
                     format!("{:>5.2}", x / m)
                 } else {
                     "    -".to_string()
@@ -82,48 +179,129 @@ pub(super) fn print_result(p: &Problem, result: &IdentResult, seconds: f64) {
             );
         }
     }
+}
+
+/// One line per plane and circle centre: how well the identified model reproduces its tests.
+fn print_groups(p: &Problem, result: &IdentResult) {
+    // (plane + centre, tests, z values with the label of their test and EIJ).
+    let mut groups: Vec<(String, usize, Vec<(f64, String)>)> = Vec::new();
+    for (i, t) in p.tests().iter().enumerate() {
+        let label = t.label();
+        let key = match label.split_once(" @ ") {
+            Some((_, at)) => format!("{} @ {at}", t.circle.plane),
+            None => t.circle.plane.to_string(),
+        };
+        let z: Vec<(f64, String)> = t
+            .measured
+            .iter()
+            .map(|(e, (m, s))| {
+                let sim = result.simulated_final[i]
+                    .get(e)
+                    .copied()
+                    .unwrap_or(f64::NAN);
+                (
+                    (sim - m) / s,
+                    format!(
+                        "{} {} {} {e}",
+                        t.circle.plane,
+                        t.circle.direction,
+                        short_accel(t)
+                    ),
+                )
+            })
+            .collect();
+        match groups.iter_mut().find(|g| g.0 == key) {
+            Some(g) => {
+                g.1 += 1;
+                g.2.extend(z);
+            }
+            None => groups.push((key, 1, z)),
+        }
+    }
+    println!(
+        "\n  per plane and circle centre: z = (identified model − measured) / σ over the EIJ of its tests\n  \
+         {:<28} tests  values  rms z  max |z| (test, EIJ)",
+        "plane @ circle centre"
+    );
+    for (key, n, z) in &groups {
+        let rms = (z.iter().map(|(v, _)| v * v).sum::<f64>() / z.len().max(1) as f64).sqrt();
+        let worst = z
+            .iter()
+            .max_by(|a, b| a.0.abs().total_cmp(&b.0.abs()))
+            .map(|(v, l)| format!("{:.1} ({l})", v.abs()))
+            .unwrap_or_default();
+        println!(
+            "  {:<28} {:>5}  {:>6}  {:>5.2}  {}",
+            key,
+            n,
+            z.len(),
+            rms,
+            worst
+        );
+    }
+}
+
+/// The set acceleration as written in labels: `5`, `2.5`.
+fn short_accel(t: &eij::ident::TestCase) -> String {
+    let s = format!("{:.2}", t.circle.accel_m_s2);
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
+/// Median simulated/measured before and after over the values beyond 3σ.
+fn print_ratios(p: &Problem, result: &IdentResult) {
     let (mut before, mut after) = (Vec::new(), Vec::new());
     for (i, t) in p.tests().iter().enumerate() {
         for (e, (m, s)) in &t.measured {
-            if m.abs() > 3.0 * s {
+            if m.abs() > RATIO_SIGMAS * s {
                 before.push(result.simulated_initial[i][e] / m);
                 after.push(result.simulated_final[i][e] / m);
             }
         }
     }
-    if !before.is_empty() {
-        let median = |v: &mut Vec<f64>| {
-            v.sort_by(f64::total_cmp);
-            v[v.len() / 2]
-        };
-        println!(
-            "\nsimulated/measured over the {} values beyond 3σ: median {:.2} with the catalogue model, {:.2} identified",
-            before.len(),
-            median(&mut before),
-            median(&mut after)
-        );
-    }
-    print_statics(result);
-    print_fitted_clocks(result);
-    if let Some(d) = &result.design {
-        print_design(d);
-    }
-    for n in &result.notes {
-        println!("note: {n}");
-    }
-}
-
-/// The fitted static terms per group.
-fn print_statics(result: &IdentResult) {
-    if result.static_estimates.is_empty() {
+    if before.is_empty() {
         return;
     }
-    println!("\n  static terms (µm per mm of set position; acceleration-independent, fitted with the EIJ)");
+    let median = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    println!(
+        "\nsimulated/measured over the {} values beyond {RATIO_SIGMAS}σ: median {:.2} with the catalogue model, {:.2} identified",
+        before.len(),
+        median(&mut before),
+        median(&mut after)
+    );
+}
+
+/// The fitted static terms: one summary line, with `tables` every group.
+fn print_statics(result: &IdentResult, tables: bool) {
+    let terms: Vec<_> = result
+        .static_estimates
+        .iter()
+        .filter(|e| e.clock.is_none())
+        .collect();
+    let Some(largest) = terms
+        .iter()
+        .max_by(|a, b| a.value_um_per_mm.abs().total_cmp(&b.value_um_per_mm.abs()))
+    else {
+        return;
+    };
+    println!(
+        "\n  static terms (geometry fitted with the EIJ, µm per mm of set position): {} in {} groups, largest {} {:+.3} ± {:.3} ({})",
+        terms.len(),
+        result.statics.groups.len(),
+        geometric_name(largest.eij),
+        largest.value_um_per_mm,
+        largest.std_err_um_per_mm,
+        result.statics.groups[largest.group].label()
+    );
+    if !tables {
+        return;
+    }
     for (g, group) in result.statics.groups.iter().enumerate() {
-        let terms: Vec<String> = result
-            .static_estimates
+        let terms: Vec<String> = terms
             .iter()
-            .filter(|e| e.group == g && e.clock.is_none())
+            .filter(|e| e.group == g)
             .map(|e| {
                 format!(
                     "{}{} {:+.3} ± {:.3}",
@@ -140,36 +318,40 @@ fn print_statics(result: &IdentResult) {
     }
 }
 
-/// The clock offsets fitted with the EIJ.
-fn print_fitted_clocks(result: &IdentResult) {
+/// The clock offsets fitted with the EIJ: the largest, with `tables` all.
+fn print_fitted_clocks(result: &IdentResult, tables: bool) {
     let fitted = eij::ident::diagnosis::fitted_clocks(result);
-    if fitted.is_empty() {
+    let Some(largest) = fitted.iter().max_by(|a, b| {
+        a.external_late_ms
+            .abs()
+            .total_cmp(&b.external_late_ms.abs())
+    }) else {
         return;
-    }
+    };
     println!(
-        "\n  clock offsets fitted with the EIJ (external readings late against the internal ones)"
+        "  clock offsets fitted with the EIJ (external readings late): {}, largest {:+.4} ± {:.4} ms ({})",
+        fitted.len(),
+        largest.external_late_ms,
+        largest.std_err_ms,
+        largest.clock
     );
-    for c in fitted {
-        println!(
-            "  {:<40} {:+.4} ± {:.4} ms",
-            c.clock, c.external_late_ms, c.std_err_ms
-        );
+    if tables {
+        for c in &fitted {
+            println!(
+                "  {:<40} {:+.4} ± {:.4} ms",
+                c.clock, c.external_late_ms, c.std_err_ms
+            );
+        }
     }
 }
 
-/// The ranking of candidate additional tests.
-fn print_design(d: &Design) {
-    if d.candidates.is_empty() {
+/// The ranking of candidate additional tests: the best, with `tables` all that were kept.
+fn print_design(d: &Design, tables: bool) {
+    let Some(best) = d.candidates.first() else {
         return;
-    }
+    };
     let (now, name) = d.worst_now();
-    println!(
-        "\n  candidate additional tests ({} evaluated), ranked by the worst relative standard error they leave (now {} at {:.1} %)",
-        d.evaluated,
-        name,
-        100.0 * now
-    );
-    for (k, c) in d.candidates.iter().enumerate() {
+    let label = |c: &eij::ident::design::Candidate| {
         let pos: Vec<String> = c
             .circle
             .position_m
@@ -178,21 +360,44 @@ fn print_design(d: &Design) {
             .iter()
             .map(|v| format!("{:.0}", v * 1e3))
             .collect();
-        println!(
-            "  {:>2}. {} {:<3} {:>5.2} m/s² @ {:<16} -> worst {:.1} % ({})",
-            k + 1,
+        format!(
+            "{} {:<3} {:>5.2} m/s² @ {:<16}",
             c.circle.plane,
             c.circle.direction,
             c.circle.accel_m_s2,
-            format!("{} mm", pos.join(",")),
+            format!("{} mm", pos.join(","))
+        )
+    };
+    if !tables {
+        println!(
+            "  best additional test (of {} candidates): {} -> worst σ/value {:.1} % → {:.1} % ({})",
+            d.evaluated,
+            label(best).trim_end(),
+            100.0 * now,
+            100.0 * best.worst_rel_std_err,
+            best.worst_parameter
+        );
+        return;
+    }
+    println!(
+        "\n  candidate additional tests ({} evaluated), ranked by the worst relative standard error they leave (now {} at {:.1} %)",
+        d.evaluated,
+        name,
+        100.0 * now
+    );
+    for (k, c) in d.candidates.iter().enumerate() {
+        println!(
+            "  {:>2}. {} -> worst {:.1} % ({})",
+            k + 1,
+            label(c),
             100.0 * c.worst_rel_std_err,
             c.worst_parameter
         );
     }
 }
 
-/// The hold-out validation.
-pub(super) fn print_validation(v: &Validation) {
+/// The hold-out validation: the verdict, with `tables` one line per test.
+pub(super) fn print_validation(v: &Validation, tables: bool) {
     println!(
         "\n  hold-out validation: {} values, χ²/dof = {:.2} ({})",
         v.values,
@@ -203,8 +408,11 @@ pub(super) fn print_validation(v: &Validation) {
             "NOT predicted within the measurement uncertainty"
         }
     );
+    if !tables {
+        return;
+    }
     println!(
-        "  {:<40} rms z   max |z|   rms error   rms σ  (µm·s²/m)",
+        "  {:<40} rms z   max |z|   rms error   rms σ  (µm·s²/m; z = (predicted − measured)/σ)",
         "test"
     );
     for t in &v.tests {
@@ -215,14 +423,19 @@ pub(super) fn print_validation(v: &Validation) {
     }
 }
 
-/// The clock offsets the evaluation estimated.
-pub(super) fn print_clocks(clocks: &[eij::rtest::suite::ClockReport]) {
+/// The clock offsets the evaluation estimated: a summary, with `tables` every clock.
+pub(super) fn print_clocks(clocks: &[eij::rtest::suite::ClockReport], tables: bool) {
     if clocks.is_empty() {
         return;
     }
+    let applied = clocks.iter().filter(|c| c.applied).count();
     println!(
-        "\n  clock offsets (internal minus external clock; a lagging probe logger is negative)"
+        "  clock offsets estimated by the evaluation (internal minus external clock): {}, {applied} applied",
+        clocks.len()
     );
+    if !tables {
+        return;
+    }
     for c in clocks {
         let se = c
             .std_err_ms

@@ -27,7 +27,8 @@
 //! traits), [`statics`], [`identifiability`], [`lm`] (the Levenberg–Marquardt solver),
 //! [`uncertainty`], [`design`], [`validation`], [`settings`] (every default), [`measured`]
 //! (reading measured EIJ), [`config`] and [`report`] (files), and [`identify`], which runs them
-//! in order; [`stiffness`] gives the identified stiffness set as a table.
+//! in order; [`stiffness`] gives the identified stiffness set as a table, [`verdict`] how to
+//! read the result (each parameter's standing, the χ² test).
 
 mod acceptance;
 mod builder;
@@ -48,6 +49,7 @@ pub mod statics;
 pub mod stiffness;
 pub mod uncertainty;
 pub mod validation;
+pub mod verdict;
 
 pub use crate::predict::{EijMap, SolverKind};
 pub use builder::Identification;
@@ -123,6 +125,8 @@ pub struct IdentResult {
     pub residual_std: f64,
     /// Number of residuals m.
     pub residuals: usize,
+    /// Degrees of freedom m − n − q of s (n free parameters, q static terms).
+    pub degrees_of_freedom: usize,
     /// Iterations.
     pub iterations: u64,
     /// Parameter sets simulated (start, Jacobians, line searches, confirmation).
@@ -267,6 +271,7 @@ pub fn identify(
         cost_history,
         residual_std: fit.uncertainty.residual_std,
         residuals: r0.len(),
+        degrees_of_freedom: problem.dof(free.len()),
         iterations: fitted.iterations,
         evaluations: problem.evaluations() - evaluations_before,
         rejected_steps,

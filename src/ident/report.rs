@@ -6,6 +6,7 @@ use super::diagnosis::{
     fitted_clocks, static_groups, ClockOffsetReport, DesignReport, FittedClockReport,
     NotIdentifiableReport, StaticGroupReport, ValidationReport,
 };
+use super::verdict::{Chi2, Standing};
 use super::{IdentResult, Method, Problem, Settings, SolverKind, StaticTerms};
 use crate::axes::{Direction, Eij, Plane};
 use crate::machine::raw::{RawProvenance, RawProvenanceParameter};
@@ -115,6 +116,9 @@ pub struct IdentReport {
     /// Number of residuals m.
     #[serde(default)]
     pub residuals: Option<usize>,
+    /// Degrees of freedom of s: m − n − q (n free parameters, q static terms).
+    #[serde(default)]
+    pub degrees_of_freedom: Option<usize>,
     /// Iterations of the optimiser.
     #[serde(default)]
     pub iterations: Option<u64>,
@@ -182,6 +186,20 @@ pub struct ParameterReport {
     /// Whether it ended on a bound of the factors.
     #[serde(default)]
     pub at_bound: Option<bool>,
+}
+
+impl ParameterReport {
+    /// How well the tests determine it ([`Standing`]); without a standard error it is not
+    /// identifiable whatever its `identifiable` key says (see also
+    /// [`IdentReport::standing`]).
+    pub fn standing(&self) -> Standing {
+        Standing::of(
+            self.identified,
+            self.std_err,
+            self.identifiable.unwrap_or(true),
+            self.at_bound.unwrap_or(false),
+        )
+    }
 }
 
 /// The settings of the run in [`IdentReport`].
@@ -365,6 +383,7 @@ impl IdentReport {
             evaluations: Some(result.evaluations),
             residual_std: Some(result.residual_std),
             residuals: Some(result.residuals),
+            degrees_of_freedom: Some(result.degrees_of_freedom),
             iterations: Some(result.iterations),
             status: Some(
                 if result.refusal.is_some() {
@@ -463,6 +482,22 @@ impl IdentReport {
             self.cost_history = vec![self.cost_initial, self.cost_final];
         }
         Ok(())
+    }
+
+    /// The χ² test of the fit (`None` for reports without `residual_std` and
+    /// `degrees_of_freedom`, written by older versions).
+    pub fn chi2(&self) -> Option<Chi2> {
+        Some(Chi2::new(self.residual_std?, self.degrees_of_freedom?))
+    }
+
+    /// How well the tests determine parameter `p` ([`ParameterReport::standing`]); a parameter
+    /// the report lists under `not_identifiable` is not identifiable.
+    pub fn standing(&self, p: &ParameterReport) -> Standing {
+        if self.not_identifiable.iter().any(|n| n.name == p.name) {
+            Standing::NotIdentifiable
+        } else {
+            p.standing()
+        }
     }
 
     /// The EIJ measured in at least one test, in parameter order.

@@ -160,6 +160,10 @@ pub const NEAR_SINGULAR: f64 = 1e-8;
 /// (a warning).
 pub const WEAK_REL_STD_ERR: f64 = 0.5;
 
+/// A standard error up to this fraction of the value marks a determined parameter (above it,
+/// up to [`WEAK_REL_STD_ERR`], a loosely determined one; see [`super::verdict`]).
+pub const DETERMINED_REL_STD_ERR: f64 = 0.1;
+
 /// The χ² test fails (a warning) when s² exceeds 1 by more than this many of its standard
 /// deviations √(2/(m − n)).
 pub const CHI2_SIGMAS: f64 = 4.0;

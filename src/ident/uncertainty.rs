@@ -9,7 +9,7 @@
 //! * warnings: a near-singular combination, a failed χ² test, a weakly determined parameter.
 
 use super::parameters::to_factor;
-use super::settings::{CHI2_SIGMAS, NEAR_SINGULAR, WEAK_REL_STD_ERR};
+use super::settings::{NEAR_SINGULAR, WEAK_REL_STD_ERR};
 use super::IdentError;
 use nalgebra::DMatrix;
 
@@ -63,7 +63,7 @@ impl Uncertainty {
             }
         }
         // χ² test of the fit: with honest σ, s² = χ²/(m − n) scatters about 1 by √(2/(m − n)).
-        let chi2_failed = s2 > 1.0 + CHI2_SIGMAS * (2.0 / dof).sqrt();
+        let chi2_failed = !super::verdict::Chi2::new(s2.sqrt(), dof as usize).passed;
         if chi2_failed {
             warnings.push(format!(
                 "χ² test failed: residual std s = {:.2} ≫ 1, the model cannot reproduce the measured EIJ within their uncertainty (a missing parameter, a model error, or σ too small). The standard errors (scaled by s) do not cover such a model error: the identified factors may be off by more than they say",

@@ -1,0 +1,167 @@
+//! How to read an identification: how well the tests determine each parameter, and whether
+//! the fit passes its χ² test. One rule for the console (`eij identify`) and the HTML report
+//! (`eij report`), so that neither calls a factor of 9.998 ± 86 "identified".
+//!
+//! A parameter's standing follows from its relative standard error σ_p/p:
+//!
+//! | standing | rule |
+//! | --- | --- |
+//! | not identifiable | the tests cannot determine it (no influence, or tied to others): kept at its start value, no standard error |
+//! | on a bound | ended within [`super::settings::AT_BOUND_REL`] of a bound of the factors: the data want a value outside |
+//! | not determined | σ_p/p > [`NOT_IDENTIFIABLE_REL_STD_ERR`] (100 %): the standard error exceeds the value itself |
+//! | weak | σ_p/p > [`WEAK_REL_STD_ERR`] (50 %) |
+//! | loose | σ_p/p > [`DETERMINED_REL_STD_ERR`] (10 %) |
+//! | determined | σ_p/p ≤ 10 % |
+//!
+//! The χ² test: with honest measurement uncertainties σ, s² = Σr²/dof scatters about 1 with a
+//! standard deviation √(2/dof); the fit fails when s² > 1 + [`CHI2_SIGMAS`]·√(2/dof) (the
+//! model cannot reproduce the measured EIJ within their uncertainty, and the standard errors,
+//! scaled by s, do not cover that model error).
+
+use super::settings::{
+    CHI2_SIGMAS, DETERMINED_REL_STD_ERR, NOT_IDENTIFIABLE_REL_STD_ERR, PLAUSIBLE_MAX,
+    PLAUSIBLE_MIN, WEAK_REL_STD_ERR,
+};
+
+/// How well the tests determine one parameter (see the module docs for the rules).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Standing {
+    /// Kept at its start value: the tests cannot determine it.
+    NotIdentifiable,
+    /// Ended on a bound of the factors.
+    OnBound,
+    /// Standard error above the value.
+    NotDetermined {
+        /// σ_p/p.
+        rel: f64,
+    },
+    /// Standard error above half the value.
+    Weak {
+        /// σ_p/p.
+        rel: f64,
+    },
+    /// Standard error above a tenth of the value.
+    Loose {
+        /// σ_p/p.
+        rel: f64,
+    },
+    /// Standard error at most a tenth of the value.
+    Determined {
+        /// σ_p/p.
+        rel: f64,
+    },
+}
+
+impl Standing {
+    /// The standing of a parameter identified as `value` ± `std_err` (`None`: not
+    /// identifiable), `identifiable` and `at_bound` as the identification says.
+    pub fn of(value: f64, std_err: Option<f64>, identifiable: bool, at_bound: bool) -> Standing {
+        let Some(se) = std_err.filter(|_| identifiable) else {
+            return Standing::NotIdentifiable;
+        };
+        if at_bound {
+            return Standing::OnBound;
+        }
+        let rel = if value != 0.0 {
+            (se / value).abs()
+        } else {
+            f64::INFINITY
+        };
+        // NaN (a standard error that could not be computed) counts as not determined.
+        if rel.is_nan() || rel > NOT_IDENTIFIABLE_REL_STD_ERR {
+            Standing::NotDetermined { rel }
+        } else if rel > WEAK_REL_STD_ERR {
+            Standing::Weak { rel }
+        } else if rel > DETERMINED_REL_STD_ERR {
+            Standing::Loose { rel }
+        } else {
+            Standing::Determined { rel }
+        }
+    }
+
+    /// The word for tables: `determined`, `loose`, `weak`, `NOT determined`, `NOT identifiable`,
+    /// `ON A BOUND`; the last three in capitals because the value must not be used.
+    pub fn label(self) -> &'static str {
+        match self {
+            Standing::NotIdentifiable => "NOT identifiable",
+            Standing::OnBound => "ON A BOUND",
+            Standing::NotDetermined { .. } => "NOT determined",
+            Standing::Weak { .. } => "weak",
+            Standing::Loose { .. } => "loose",
+            Standing::Determined { .. } => "determined",
+        }
+    }
+
+    /// The relative standard error σ_p/p, where there is one.
+    pub fn rel_std_err(self) -> Option<f64> {
+        match self {
+            Standing::NotDetermined { rel }
+            | Standing::Weak { rel }
+            | Standing::Loose { rel }
+            | Standing::Determined { rel } => Some(rel),
+            Standing::NotIdentifiable | Standing::OnBound => None,
+        }
+    }
+
+    /// Whether the value may be used as identified (determined or loose).
+    pub fn usable(self) -> bool {
+        matches!(self, Standing::Determined { .. } | Standing::Loose { .. })
+    }
+
+    /// One line that explains the words of [`Standing::label`].
+    pub fn legend() -> String {
+        format!(
+            "standing from the relative standard error σ/value: determined ≤ {:.0} %, loose ≤ {:.0} %, weak ≤ {:.0} %, NOT determined above; NOT identifiable = the tests cannot determine it (kept at its start value); ON A BOUND = the data want a value outside the bounds",
+            100.0 * DETERMINED_REL_STD_ERR,
+            100.0 * WEAK_REL_STD_ERR,
+            100.0 * NOT_IDENTIFIABLE_REL_STD_ERR
+        )
+    }
+}
+
+/// Whether an identified reduction factor is implausible: stiffer than its catalogue data
+/// (above [`PLAUSIBLE_MAX`]) or more than ten times softer (below [`PLAUSIBLE_MIN`]).
+pub fn implausible(value: f64) -> bool {
+    !(PLAUSIBLE_MIN..=PLAUSIBLE_MAX).contains(&value)
+}
+
+/// The χ² test of a fit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Chi2 {
+    /// Residual standard deviation s = √(Σr²/dof).
+    pub s: f64,
+    /// Degrees of freedom m − n − q.
+    pub dof: usize,
+    /// The largest s that passes.
+    pub s_limit: f64,
+    /// s ≤ s_limit.
+    pub passed: bool,
+}
+
+impl Chi2 {
+    /// The test of residual standard deviation `s` over `dof` degrees of freedom.
+    pub fn new(s: f64, dof: usize) -> Chi2 {
+        let s_limit = (1.0 + CHI2_SIGMAS * (2.0 / dof.max(1) as f64).sqrt()).sqrt();
+        Chi2 {
+            s,
+            dof,
+            s_limit,
+            passed: s <= s_limit,
+        }
+    }
+
+    /// `passed: s = 0.949 ≤ 1.196 over 172 degrees of freedom: …` or `FAILED: …`.
+    pub fn describe(&self) -> String {
+        if self.passed {
+            format!(
+                "passed: s = {:.3} ≤ {:.3} over {} degrees of freedom: the model reproduces the measured EIJ within their uncertainty",
+                self.s, self.s_limit, self.dof
+            )
+        } else {
+            format!(
+                "FAILED: s = {:.3} > {:.3} over {} degrees of freedom: the model cannot reproduce the measured EIJ within their uncertainty, and the standard errors do not cover that model error",
+                self.s, self.s_limit, self.dof
+            )
+        }
+    }
+}

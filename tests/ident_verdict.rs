@@ -1,0 +1,73 @@
+//! How an identification is read (`eij::ident::verdict`): each parameter's standing from its
+//! relative standard error, the χ² test, and the report's own keys overruling a bare
+//! `identifiable: true`.
+
+use eij::ident::report::IdentReport;
+use eij::ident::verdict::{implausible, Chi2, Standing};
+
+#[test]
+fn standing_follows_the_relative_standard_error() {
+    // The example: 9.998 ± 86 is 860 % — nothing is known about it.
+    let s = Standing::of(9.998, Some(86.0), true, false);
+    assert_eq!(s, Standing::NotDetermined { rel: 86.0 / 9.998 });
+    assert!(!s.usable());
+    assert_eq!(s.label(), "NOT determined");
+    assert_eq!(Standing::of(0.4, Some(0.3), true, false).label(), "weak");
+    assert_eq!(Standing::of(0.4, Some(0.1), true, false).label(), "loose");
+    assert_eq!(
+        Standing::of(0.4, Some(0.04), true, false).label(),
+        "determined"
+    );
+    assert_eq!(Standing::of(0.4, Some(0.041), true, false).label(), "loose");
+    assert_eq!(
+        Standing::of(0.4, None, true, false),
+        Standing::NotIdentifiable
+    );
+    assert_eq!(
+        Standing::of(0.4, Some(0.01), false, false),
+        Standing::NotIdentifiable
+    );
+    assert_eq!(
+        Standing::of(10.0, Some(0.01), true, true),
+        Standing::OnBound
+    );
+    assert_eq!(
+        Standing::of(0.4, Some(f64::NAN), true, false).label(),
+        "NOT determined"
+    );
+    assert!(implausible(1.2) && implausible(0.05) && !implausible(0.45));
+}
+
+#[test]
+fn chi2_limit_is_one_plus_four_standard_deviations_of_s_squared() {
+    // dof = 172: s² ≤ 1 + 4·√(2/172) = 1.431331…, s ≤ 1.196383…
+    let c = Chi2::new(0.949, 172);
+    assert!((c.s_limit - 1.196_383).abs() < 1e-6, "{}", c.s_limit);
+    assert!(c.passed);
+    assert!(c
+        .describe()
+        .starts_with("passed: s = 0.949 ≤ 1.196 over 172"));
+    assert!(!Chi2::new(1.2, 172).passed);
+    assert!(Chi2::new(1.5, 2).passed, "s² = 2.25 ≤ 1 + 4·1 = 5");
+}
+
+#[test]
+fn a_parameter_listed_not_identifiable_is_not_identifiable_whatever_its_flag_says() {
+    let v = serde_json::json!({
+        "parameters": [
+            {"name": "x.guideway_normal", "initial": 1.0, "identified": 9.998, "std_err": 86.0, "identifiable": true},
+            {"name": "x.screw", "initial": 1.0, "identified": 1.0, "std_err": 0.02, "identifiable": true}
+        ],
+        "correlation": [[1.0, 0.0], [0.0, 1.0]],
+        "cost_initial": 10.0, "cost_final": 5.0, "residual_std": 1.1, "degrees_of_freedom": 40,
+        "not_identifiable": [{"name": "x.screw", "reason": "no influence"}],
+        "tests": [{"plane": "zx", "direction": "ccw", "accel_m_s2": 5.0,
+                   "measured": {"EZZ": -1.0}, "simulated_initial": {"EZZ": -0.5},
+                   "simulated_final": {"EZZ": -1.0}}]
+    });
+    let r = IdentReport::from_value(&v).unwrap();
+    assert_eq!(r.standing(&r.parameters[0]).label(), "NOT determined");
+    assert_eq!(r.standing(&r.parameters[1]), Standing::NotIdentifiable);
+    let c = r.chi2().unwrap();
+    assert_eq!((c.dof, c.passed), (40, true));
+}
