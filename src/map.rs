@@ -209,14 +209,16 @@ pub fn eij_map(
 }
 
 /// The compensation table as CSV: `x_mm,y_mm,z_mm,plane,direction,radius_mm,accel_m_s2`, then
-/// one `<EIJ>_um_s2_per_m` column per parameter of the plane.
+/// one `<EIJ>_um_s2_per_m` column per parameter of the plane, then `machine` (its name, so
+/// that a figure of the table says which machine it maps).
 pub fn to_csv(machine: &Machine, spec: &MapSpec, points: &[MapPoint]) -> String {
     let params = spec.plane.parameters();
     let mut out = String::from("x_mm,y_mm,z_mm,plane,direction,radius_mm,accel_m_s2");
     for p in &params {
         out.push_str(&format!(",{p}_um_s2_per_m"));
     }
-    out.push('\n');
+    out.push_str(",machine\n");
+    let name = csv_field(machine.name());
     for pt in points {
         let mut xyz = [0.0; 3];
         for (a, v) in machine.axes().iter().zip(&pt.position_m) {
@@ -235,14 +237,35 @@ pub fn to_csv(machine: &Machine, spec: &MapSpec, points: &[MapPoint]) -> String 
         for p in &params {
             out.push_str(&format!(",{:.6}", pt.eij[p]));
         }
+        out.push(',');
+        out.push_str(&name);
         out.push('\n');
     }
     out
 }
 
-/// Reads a compensation table written by [`to_csv`]: the map's conditions and its points, with
-/// positions in x, y, z order.
-pub fn read_csv(path: &std::path::Path) -> Result<(MapSpec, Vec<MapPoint>), MapError> {
+/// A CSV field: quoted (quotes doubled) where it holds a separator, a quote or a line break.
+fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+/// A compensation table read back ([`read_csv`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct MapTable {
+    /// The conditions of its circles.
+    pub spec: MapSpec,
+    /// Its grid points, positions in x, y, z order.
+    pub points: Vec<MapPoint>,
+    /// The machine it maps (`None` for tables written before the `machine` column).
+    pub machine: Option<String>,
+}
+
+/// Reads a compensation table written by [`to_csv`] (with or without its `machine` column).
+pub fn read_csv(path: &std::path::Path) -> Result<MapTable, MapError> {
     let name = path.display().to_string();
     let bad = |line: usize, m: String| MapError::Table {
         at: format!("{name}:{line}"),
@@ -270,16 +293,18 @@ pub fn read_csv(path: &std::path::Path) -> Result<(MapSpec, Vec<MapPoint>), MapE
         "radius_mm",
         "accel_m_s2",
     ];
-    if header.len() != fixed.len() + 6 || header[..fixed.len()] != fixed {
+    let with_machine = header.last().is_some_and(|h| h == "machine");
+    let eij_end = header.len() - usize::from(with_machine);
+    if eij_end != fixed.len() + 6 || header[..fixed.len()] != fixed {
         return Err(bad(
             1,
             format!(
-                "not an eij map table (expected {},<six EIJ>_um_s2_per_m)",
+                "not an eij map table (expected {},<six EIJ>_um_s2_per_m[,machine])",
                 fixed.join(",")
             ),
         ));
     }
-    let params: Vec<Eij> = header[fixed.len()..]
+    let params: Vec<Eij> = header[fixed.len()..eij_end]
         .iter()
         .map(|h| h.strip_suffix("_um_s2_per_m").unwrap_or(h).parse::<Eij>())
         .collect::<Result<_, _>>()
@@ -295,6 +320,7 @@ pub fn read_csv(path: &std::path::Path) -> Result<(MapSpec, Vec<MapPoint>), MapE
         ));
     }
     let mut spec: Option<MapSpec> = None;
+    let mut machine = None;
     let mut points: Vec<MapPoint> = Vec::new();
     // Grid positions as read, with their line: a point given twice would silently weigh twice.
     let mut seen: BTreeMap<[u64; 3], usize> = BTreeMap::new();
@@ -325,6 +351,9 @@ pub fn read_csv(path: &std::path::Path) -> Result<(MapSpec, Vec<MapPoint>), MapE
             return Err(bad(line, "conditions differ from the first row".into()));
         }
         spec = Some(this);
+        if with_machine {
+            machine = rec.get(eij_end).map(str::to_string);
+        }
         let mut eij = BTreeMap::new();
         for (k, p) in params.iter().enumerate() {
             eij.insert(*p, num(fixed.len() + k)?);
@@ -345,5 +374,9 @@ pub fn read_csv(path: &std::path::Path) -> Result<(MapSpec, Vec<MapPoint>), MapE
         });
     }
     let spec = spec.ok_or_else(|| bad(2, "no rows".into()))?;
-    Ok((spec, points))
+    Ok(MapTable {
+        spec,
+        points,
+        machine,
+    })
 }

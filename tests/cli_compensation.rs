@@ -18,8 +18,17 @@ fn identified() -> &'static (Scratch, String, String) {
     static CELL: OnceLock<(Scratch, String, String)> = OnceLock::new();
     CELL.get_or_init(|| {
         let s = Scratch::new("compensation");
-        let machine = s.s("id.toml");
-        let r = run(&["identify", "--quiet", "--no-design", "--out", &machine]);
+        let (machine, report) = (s.s("id.toml"), s.s("id.json"));
+        // --report too: the default one would replace out/demo-vmc-identify-report.json.
+        let r = run(&[
+            "identify",
+            "--quiet",
+            "--no-design",
+            "--out",
+            &machine,
+            "--report",
+            &report,
+        ]);
         assert!(r.ok, "{}", r.stderr);
         let table = s.s("table.csv");
         let r = run(&["compensation", "--machine", &machine, "--out", &table]);
@@ -322,16 +331,10 @@ fn the_report_shows_the_compensated_move_and_move_against_circle_eij() {
     assert!(html.contains("EIJ from the moves and from the circles"));
     // Both moves give EXZ near the circles' mean, in the table's rows.
     assert_eq!(html.matches("<td>EXZ</td>").count(), 2, "{html}");
-    let svgs: Vec<String> = std::fs::read_dir(&out)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| {
-            p.file_name()
-                .unwrap()
-                .to_string_lossy()
-                .starts_with("move-")
-        })
-        .map(|p| std::fs::read_to_string(p).unwrap())
+    // The move figures, inline in the page.
+    let svgs: Vec<&str> = html
+        .match_indices("<figure id=\"move-")
+        .map(|(i, _)| &html[i..i + html[i..].find("</figure>").unwrap()])
         .collect();
     assert_eq!(svgs.len(), 2);
     let with = svgs

@@ -359,6 +359,9 @@ fn a_file_without_its_set_radius_says_which_radius_was_assumed() {
         .arg(&file)
         .arg("--out")
         .arg(s.path("id.toml"))
+        // Not the default report: that would replace out/demo-vmc-identify-report.json.
+        .arg("--report")
+        .arg(s.path("id.json"))
         .output()
         .unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);

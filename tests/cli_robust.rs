@@ -256,11 +256,11 @@ fn no_output_replaces_a_file_read_directly_or_indirectly() {
         &["evaluate", &meas, "--csv-out", &cond],
         &format!("{cond}: refusing to overwrite an input file"),
     );
-    // A map given to the report, named like one of the report's figures.
+    // A map given to the report, named like the report's page.
     let rep = s.s("rep");
     std::fs::create_dir(&rep).unwrap();
     let (text, _) = demo_map(&s);
-    let own = s.write("rep/map-01.svg", text);
+    let own = s.write("rep/report.html", text);
     refused(
         &s,
         &["report", "--measured", &input, "--map", &own, "--out", &rep],
@@ -530,7 +530,7 @@ fn messages_are_short_and_blame_the_right_thing() {
             "--out",
             &s.s("rep"),
         ],
-        &format!("{extra}:4: 14 field(s), the header has 13"),
+        &format!("{extra}:4: 15 field(s), the header has 14"),
     );
     assert!(!line.contains("CSV error"), "{line}");
 }

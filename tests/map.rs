@@ -70,10 +70,11 @@ fn compensation_table_round_trips_and_bad_grids_are_refused() {
     std::fs::create_dir_all(&dir).unwrap();
     let file = dir.join("map.csv");
     std::fs::write(&file, to_csv(&m, &spec(), &points)).unwrap();
-    let (spec_back, back) = read_csv(&file).unwrap();
+    let table = read_csv(&file).unwrap();
     std::fs::remove_dir_all(&dir).unwrap();
-    assert_eq!(spec_back, spec());
-    for (a, b) in points.iter().zip(&back) {
+    assert_eq!(table.spec, spec());
+    assert_eq!(table.machine.as_deref(), Some(m.name()));
+    for (a, b) in points.iter().zip(&table.points) {
         for (e, v) in &a.eij {
             assert!((b.eij[e] - v).abs() < 1e-6);
         }
@@ -86,7 +87,9 @@ fn compensation_table_round_trips_and_bad_grids_are_refused() {
     let doc = roxmltree::Document::parse(&svg).unwrap();
     let texts: Vec<&str> = doc.descendants().filter_map(|n| n.text()).collect();
     assert!(
-        texts.iter().any(|t| t.contains("EIJ map over Y")),
+        texts
+            .iter()
+            .any(|t| t.trim().starts_with("EIJ map of demo: zx ccw circles")),
         "{texts:?}"
     );
     assert!(texts.iter().any(|t| t.contains("EXZ / (µm·s²/m)")));

@@ -310,14 +310,23 @@ fn identification_figure_has_a_panel_per_parameter_and_the_cost() {
     let y: Vec<f64> = cost[0].points.iter().map(|p| p.1).collect();
     let ratio = ((y[1] - y[0]) / (y[2] - y[1]) - (400f64 / 30.0).ln() / (30f64 / 2.6).ln()).abs();
     assert!(ratio < 0.05, "log scale: steps {y:?}");
-    // Error bars: one vertical two-point polyline per measured value (5), plus the legend's.
-    let bars = doc
-        .polylines
-        .iter()
-        .filter(|p| p.stroke == svg_color(svg::ERROR_BAR) && p.points.len() == 2)
-        .filter(|p| (p.points[0].0 - p.points[1].0).abs() < 0.5)
-        .count();
-    assert_eq!(bars, 5 + 1);
+    // Error bars: one horizontal two-point polyline per measured value (5, one row per test),
+    // and the legend's vertical one.
+    let bars = |horizontal: bool| {
+        doc.polylines
+            .iter()
+            .filter(|p| p.stroke == svg_color(svg::ERROR_BAR) && p.points.len() == 2)
+            .filter(|p| {
+                let (dx, dy) = (p.points[0].0 - p.points[1].0, p.points[0].1 - p.points[1].1);
+                if horizontal {
+                    dy.abs() < 0.5 && dx.abs() > 0.5
+                } else {
+                    dx.abs() < 0.5
+                }
+            })
+            .count()
+    };
+    assert_eq!((bars(true), bars(false)), (5, 1));
     // Measured (black), initial (grey rings, no fill), final (green) markers.
     let fills = |c| doc.circles.iter().filter(|f| **f == svg_color(c)).count();
     assert_eq!(fills(svg::SET), 5 + 1);

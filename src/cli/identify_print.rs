@@ -183,8 +183,10 @@ fn print_eij_table(p: &Problem, result: &IdentResult) {
 
 /// One line per plane and circle centre: how well the identified model reproduces its tests.
 fn print_groups(p: &Problem, result: &IdentResult) {
-    // (plane + centre, tests, z values with the label of their test and EIJ).
-    let mut groups: Vec<(String, usize, Vec<(f64, String)>)> = Vec::new();
+    // z values with the label of their test and EIJ.
+    type Zs = Vec<(f64, String)>;
+    // (plane + centre, tests, z values).
+    let mut groups: Vec<(String, usize, Zs)> = Vec::new();
     for (i, t) in p.tests().iter().enumerate() {
         let label = t.label();
         let key = match label.split_once(" @ ") {

@@ -1,4 +1,5 @@
-//! `eij report --measured PATH... [--identify-report FILE.json] [--move FILE.csv...] --out DIR`
+//! `eij report --measured PATH... [--identify-report FILE.json]... [--move FILE.csv...]
+//! [--map FILE.csv...] --out DIR`
 
 use std::path::PathBuf;
 
@@ -11,51 +12,58 @@ pub struct ReportArgs {
     /// rtest.toml gives the set radius and the circle centre position).
     #[arg(long, value_name = "PATH", num_args = 1.., required = true)]
     measured: Vec<PathBuf>,
-    /// Report JSON of `eij identify --report`: parameters, correlations, per-test table and
-    /// figure.
+    /// Report JSON of `eij identify --report`: verdict, parameters, correlations, per-test
+    /// table and figure. Repeatable: several reports (before/after a repair, two machines, two
+    /// dates) are compared side by side, in the order given.
     #[arg(long, value_name = "FILE.json")]
-    identify_report: Option<PathBuf>,
+    identify_report: Vec<PathBuf>,
     /// Simulated move CSVs (`eij simulate move`), one figure each.
     #[arg(long = "move", value_name = "FILE.csv", num_args = 1..)]
     moves: Vec<PathBuf>,
     /// EIJ maps (`eij map` compensation tables), one figure each.
     #[arg(long = "map", value_name = "FILE.csv", num_args = 1..)]
     maps: Vec<PathBuf>,
-    /// Report folder: report.html and the SVG figures (created if missing; only the report's
-    /// own files in it are replaced).
+    /// Report folder: report.html, one self-contained page with every figure inline (created
+    /// if missing; only report.html in it is replaced).
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
 }
 
 /// Runs `eij report`.
 pub fn run(args: ReportArgs) -> anyhow::Result<()> {
-    let written = report::generate(&ReportRequest {
+    let page = report::generate(&ReportRequest {
         measured: args.measured,
-        identify_report: args.identify_report,
+        identify_reports: args.identify_report,
         moves: args.moves,
         extra_figures: map_figures(&args.maps)?,
-        out_dir: args.out.clone(),
+        out_dir: args.out,
     })?;
     eprintln!(
-        "report: {} files written, open {}",
-        written.len(),
-        args.out.join(report::html::REPORT_FILE).display()
+        "report: wrote {} (one page, figures inline)",
+        page.display()
     );
     Ok(())
 }
 
-/// One figure per EIJ map table.
+/// One figure per EIJ map table, titled by the machine it maps.
 fn map_figures(maps: &[PathBuf]) -> anyhow::Result<Vec<report::html::Figure>> {
     let axes = eij::axes::Axis::ALL;
     maps.iter()
         .enumerate()
         .map(|(i, path)| {
-            let (spec, points) = eij::map::read_csv(path)?;
-            let svg = report::map_svg(&path.display().to_string(), &axes, &spec, &points)?;
+            let table = eij::map::read_csv(path)?;
+            let machine = table.machine.clone().unwrap_or_else(|| {
+                format!(
+                    "an unnamed machine ({} has no machine column)",
+                    path.display()
+                )
+            });
+            let spec = &table.spec;
+            let svg = report::map_svg(&machine, &axes, spec, &table.points)?;
             Ok(report::html::Figure {
-                file_name: format!("map-{:02}.svg", i + 1),
+                id: format!("map-{}", i + 1),
                 caption: format!(
-                    "EIJ map {} ({} {}, {} m/s²)",
+                    "EIJ map of {machine} ({}): {} {} circles at {} m/s²",
                     path.display(),
                     spec.plane,
                     spec.direction,

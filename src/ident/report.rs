@@ -28,17 +28,23 @@ pub struct Provenance {
 impl Provenance {
     /// Provenance with the current (or SOURCE_DATE_EPOCH) time.
     pub fn now(machine_file: String, measured: Vec<String>) -> Self {
-        let time = std::env::var("SOURCE_DATE_EPOCH")
-            .ok()
-            .and_then(|s| s.trim().parse::<u64>().ok())
-            .map(|s| std::time::UNIX_EPOCH + std::time::Duration::from_secs(s))
-            .unwrap_or_else(std::time::SystemTime::now);
         Provenance {
             machine_file,
             measured,
-            date: humantime::format_rfc3339_seconds(time).to_string(),
+            date: utc_timestamp(),
         }
     }
+}
+
+/// The current UTC time (RFC 3339, seconds), or SOURCE_DATE_EPOCH when set, for reproducible
+/// outputs.
+pub fn utc_timestamp() -> String {
+    let time = std::env::var("SOURCE_DATE_EPOCH")
+        .ok()
+        .and_then(|s| s.trim().parse::<u64>().ok())
+        .map(|s| std::time::UNIX_EPOCH + std::time::Duration::from_secs(s))
+        .unwrap_or_else(std::time::SystemTime::now);
+    humantime::format_rfc3339_seconds(time).to_string()
 }
 
 /// EIJ values by parameter, µm·s²/m. A value a simulation lacks is NaN, written as `null`.

@@ -242,30 +242,52 @@ impl CircleView {
         })
     }
 
-    /// Out-of-plane view: d_k over the phase φ with the fitted plane
-    /// d_k = E_ka ä_a + E_kb ä_b + c_k, ä = −r ω² (cos φ, sin φ).
-    pub fn out_of_plane_svg(&self, cond: &Conditions) -> Result<String, ReportError> {
-        let n = self.norm.samples();
+    /// The out-of-plane deviation d_k over the phase φ (°, of at most `max_points` samples)
+    /// and the fitted plane d_k = E_ka ä_a + E_kb ä_b + c_k, ä = −r ω² (cos φ, sin φ), over
+    /// 0…360°.
+    pub fn out_of_plane(&self, max_points: usize) -> OutOfPlane {
         let (a, b) = self.norm.plane.axes();
         let k = self.norm.plane.normal();
         let [sa, sb] = &self.norm.set_mm;
         let dk = &self.norm.dev_um[2];
         let phase_deg = |i: usize| sb[i].atan2(sa[i]).to_degrees().rem_euclid(360.0);
-        let points: Vec<(f64, f64)> = svg::decimate(n, MAX_SCATTER_POINTS)
+        let points = svg::decimate(self.norm.samples(), max_points)
             .map(|i| (phase_deg(i), dk[i]))
             .collect();
+        let (e_ka, e_kb) = (Eij::new(k, a), Eij::new(k, b));
+        let (eka, ekb) = (self.joint.eij[&e_ka], self.joint.eij[&e_kb]);
+        let c_k_um = self.joint.offsets_um[&k];
+        let acc = self.accel_m_s2();
+        let plane = (0..=360)
+            .map(|d| {
+                let f = (d as f64).to_radians();
+                (d as f64, -acc * (eka * f.cos() + ekb * f.sin()) + c_k_um)
+            })
+            .collect();
+        OutOfPlane {
+            e_ka,
+            e_kb,
+            c_k_um,
+            points,
+            plane,
+        }
+    }
+
+    /// Out-of-plane view: d_k over the phase φ with the fitted plane
+    /// d_k = E_ka ä_a + E_kb ä_b + c_k, ä = −r ω² (cos φ, sin φ).
+    pub fn out_of_plane_svg(&self, cond: &Conditions) -> Result<String, ReportError> {
+        let (a, b) = self.norm.plane.axes();
+        let k = self.norm.plane.normal();
+        let OutOfPlane {
+            points,
+            plane,
+            c_k_um: ck,
+            ..
+        } = self.out_of_plane(MAX_SCATTER_POINTS);
         let (eka, ekb) = (
             self.joint.eij[&Eij::new(k, a)],
             self.joint.eij[&Eij::new(k, b)],
         );
-        let ck = self.joint.offsets_um[&k];
-        let acc = self.accel_m_s2();
-        let plane: Vec<(f64, f64)> = (0..=360)
-            .map(|d| {
-                let f = (d as f64).to_radians();
-                (d as f64, -acc * (eka * f.cos() + ekb * f.sin()) + ck)
-            })
-            .collect();
         let (lo, hi) = svg::padded_range(points.iter().chain(&plane).map(|p| p.1), 0.08);
         let title = format!(
             "Circle test {} {}: out-of-plane deviation d{} over the phase",
@@ -324,6 +346,21 @@ impl CircleView {
             svg::side_panel(&right, &legend, &notes)
         })
     }
+}
+
+/// The out-of-plane deviation of a test ([`CircleView::out_of_plane`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct OutOfPlane {
+    /// E_ka: deviation along the plane normal k per acceleration of the plane's first axis.
+    pub e_ka: Eij,
+    /// E_kb: the same for the second axis.
+    pub e_kb: Eij,
+    /// The constant c_k, µm.
+    pub c_k_um: f64,
+    /// (phase φ / °, d_k / µm) of the measured samples.
+    pub points: Vec<(f64, f64)>,
+    /// (φ / °, d_k / µm) of the fitted plane.
+    pub plane: Vec<(f64, f64)>,
 }
 
 /// The 1-2-5 magnification that draws `max_dev_mm` as at most [`TARGET_FRACTION`] of r

@@ -20,8 +20,9 @@ const PALETTE: [RGBColor; 10] = [
     svg::ELLIPSE_INT,
 ];
 
-/// The map figure. `axes` are the machine's axes in its order (to read positions); the axis
-/// varying fastest along the first gridded axis is drawn on the abscissa.
+/// The map figure, titled by `machine` and the circles' conditions. `axes` are the machine's
+/// axes in its order (to read positions); the gridded axis with the most points is drawn on
+/// the abscissa (the fastest-varying one among equals), one line per position of the next.
 pub fn map_svg(
     machine: &str,
     axes: &[Axis],
@@ -42,8 +43,21 @@ pub fn map_svg(
                 .any(|p| (p.position_m[i] - points[0].position_m[i]).abs() > 1e-12)
         })
         .collect();
-    let x_axis = varying.last().copied().unwrap_or(0);
-    let group_axis = varying.iter().rev().nth(1).copied();
+    let distinct = |i: usize| {
+        let mut v: Vec<i64> = points
+            .iter()
+            .map(|p| (p.position_m[i] * 1e6).round() as i64)
+            .collect();
+        v.sort_unstable();
+        v.dedup();
+        v.len()
+    };
+    let x_axis = varying
+        .iter()
+        .copied()
+        .max_by_key(|&i| (distinct(i), i))
+        .unwrap_or(0);
+    let group_axis = varying.iter().rev().copied().find(|&i| i != x_axis);
     let mut groups: Vec<(f64, Vec<&MapPoint>)> = Vec::new();
     for p in points {
         let key = group_axis.map_or(0.0, |g| p.position_m[g]);
@@ -54,13 +68,12 @@ pub fn map_svg(
     }
     let params = spec.plane.parameters();
     let title = format!(
-        "EIJ map over {} ({}): {} circles, r = {} mm, {} m/s², {}",
-        axes[x_axis].letter(),
-        machine,
+        "EIJ map of {machine}: {} {} circles, r = {} mm, {} m/s², over {}",
         spec.plane,
+        spec.direction,
         short(spec.radius_m * 1e3, 3),
         short(spec.accel_m_s2, 3),
-        spec.direction
+        axes[x_axis].letter()
     );
     let fixed: Vec<String> = (0..axes.len())
         .filter(|i| !varying.contains(i))
@@ -84,10 +97,11 @@ pub fn map_svg(
     let (x0, x1) = svg::padded_range(xs.iter().copied(), 0.02);
     let header_px = 16 + 30 + 22 * lines.len() as u32 + 6;
     let (cols, rows) = (3usize, 2usize);
-    let panel = (440u32, 320u32);
+    // 3 × 380 + 200 px: drawn at full size on the report page (1350 px wide).
+    let panel = (380u32, 300u32);
     svg::render(
         (
-            cols as u32 * panel.0 + 260,
+            cols as u32 * panel.0 + 200,
             header_px + rows as u32 * panel.1,
         ),
         |root| {

@@ -1,5 +1,5 @@
-//! Figures and reports from eij's own data: SVG plots (plotters, SVG backend only) and an
-//! offline HTML report folder.
+//! Figures and reports from eij's own data: SVG plots (plotters, SVG backend only) and one
+//! self-contained HTML page.
 //!
 //! ```text
 //! CircleSeries ─► CircleView ─► magnified_svg      (paper Fig. 5, 8: paths, set circle, ellipses)
@@ -7,13 +7,16 @@
 //! move CSV / sim::Run ─► MoveData ─► move_svg      (paper Fig. 9: position, acceleration, cross-talk)
 //! identify report JSON ─► identification_svg        (measured vs simulated EIJ, cost history)
 //! map::eij_map points ─► map_svg                   (EIJ over the workspace)
-//! all of it ─► html::generate ─► DIR/report.html + DIR/*.svg
+//! cw/ccw pairs (rtest::suite) ─► circle_group ─► polar_svg (ISO 230-4 circle plot, µm rings)
+//!                                             └► polar::out_of_plane_svg (cw and ccw over φ)
+//! identify reports ─► verdict (standing, χ², warnings), compare (side by side)
+//! all of it ─► html::generate ─► DIR/report.html (figures inline, page::Page)
 //! ```
 //!
 //! Every figure states its conditions (source, machine where known, plane, radius, direction,
 //! acceleration, frequency, magnification, position where known) and units on its axes.
-//! Series colours are the public constants of [`svg`], so that tests and scripts can find a
-//! series in the SVG by its stroke or fill colour.
+//! Series colours are the public constants of [`svg`] and [`polar`], so that tests and
+//! scripts can find a series in the SVG by its stroke or fill colour.
 //!
 //! EIJ maps over the workspace ([`map_svg`], from `eij map`) enter a report as further
 //! [`html::Figure`]s through [`html::ReportRequest::extra_figures`].
@@ -22,12 +25,18 @@ use crate::rtest::conditions::TestConditions;
 use std::path::Path;
 
 pub mod circle;
+pub mod circle_group;
+pub mod compare;
 pub mod html;
+pub mod ident_html;
 pub mod ident_plot;
 pub mod map_plot;
 pub mod move_plot;
+pub mod page;
+pub mod polar;
 pub mod stiffness;
 pub mod svg;
+pub mod verdict;
 
 pub use circle::CircleView;
 pub use html::{generate, ReportRequest};

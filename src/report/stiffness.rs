@@ -1,7 +1,7 @@
 //! The identified stiffness set in the HTML report: one small table
 //! ([`crate::machine::stiffness`], docs/stiffness-table.md).
 
-use super::html::escape;
+use super::page::escape;
 use crate::machine::stiffness::StiffnessRow;
 use std::fmt::Write;
 
