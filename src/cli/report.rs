@@ -31,6 +31,10 @@ pub struct ReportArgs {
 
 /// Runs `eij report`.
 pub fn run(args: ReportArgs) -> anyhow::Result<()> {
+    // The page can be written (no FIFO, link or folder there) before anything is evaluated.
+    if args.out.is_dir() {
+        eij::io::check_outputs(&[&args.out.join(report::html::REPORT_FILE)], &[])?;
+    }
     let page = report::generate(&ReportRequest {
         measured: args.measured,
         identify_reports: args.identify_report,
