@@ -36,6 +36,9 @@ fn temp_name(dir: &Path, ext: &str) -> PathBuf {
 
 /// Checks that the folder of `path` takes new files, by creating and removing one.
 pub(super) fn probe_folder(path: &Path) -> Result<(), WriteError> {
+    // Like a commit: a kill between creating and removing the probe would leave it behind.
+    let _one = COMMIT.lock().unwrap_or_else(|e| e.into_inner());
+    let _held = signals::Held::new();
     let probe = temp_name(&folder_of(path), "tmp");
     std::fs::OpenOptions::new()
         .write(true)
