@@ -309,6 +309,9 @@ fn run_setpoint(
     let cond = conditions(common, &machine, &pose);
     let comp = compensate(sp, table.as_ref(), &pose, &machine);
     let rate = positive("rate-hz", common.rate_hz)?;
+    if common.plot.is_none() {
+        return stream_csv(common, &cl, sp, comp.as_ref(), rate);
+    }
     let run = match &comp {
         Some(c) => simulate(&cl, c, rate)?,
         None => simulate(&cl, sp, rate)?,
@@ -336,6 +339,49 @@ fn conditions(common: &Common, machine: &Machine, pose: &[f64]) -> Conditions {
     }
 }
 
+/// The CSV options of `common` (the noise checked).
+fn csv_options(
+    common: &Common,
+    correction: Option<Vec<f64>>,
+) -> anyhow::Result<output::CsvOptions> {
+    if !(common.noise_um.is_finite() && common.noise_um >= 0.0) {
+        bail!("--noise-um: {} must be ≥ 0", common.noise_um);
+    }
+    Ok(output::CsvOptions {
+        required_only: common.required_only,
+        decimals: common.decimals,
+        noise_um: common.noise_um,
+        seed: common.seed,
+        correction,
+    })
+}
+
+/// Simulates and writes the CSV block by block into the output's temporary file (memory
+/// independent of the run's length), renamed into place when the run is complete.
+fn stream_csv(
+    common: &Common,
+    cl: &ClosedLoop,
+    sp: &dyn SetPoint,
+    comp: Option<&Compensated>,
+    rate: f64,
+) -> anyhow::Result<()> {
+    let opts = csv_options(common, None)?;
+    let mut out = eij::io::StreamedOutput::create(&common.out, &common.inputs())?;
+    let mut csv = output::CsvStream::new(cl, &opts, comp.is_some(), out.writer())?;
+    let setpoint: &dyn SetPoint = match comp {
+        Some(c) => c,
+        None => sp,
+    };
+    eij::sim::simulate_blocks(cl, setpoint, rate, |block| -> anyhow::Result<()> {
+        let correction = comp.map(|c| corrections(c, cl, block));
+        csv.write(block, correction.as_deref())?;
+        Ok(())
+    })?;
+    csv.finish()?;
+    out.commit()?;
+    Ok(())
+}
+
 /// Writes the CSV (and the figure) of a finished run.
 fn write_output_files(
     common: &Common,
@@ -345,16 +391,7 @@ fn write_output_files(
     cond: Conditions,
     correction: Option<Vec<f64>>,
 ) -> anyhow::Result<()> {
-    if !(common.noise_um.is_finite() && common.noise_um >= 0.0) {
-        bail!("--noise-um: {} must be ≥ 0", common.noise_um);
-    }
-    let opts = output::CsvOptions {
-        required_only: common.required_only,
-        decimals: common.decimals,
-        noise_um: common.noise_um,
-        seed: common.seed,
-        correction,
-    };
+    let opts = csv_options(common, correction)?;
     let bytes = output::to_csv(cl, &run, &opts);
     let plot = match (&common.plot, kind) {
         (None, _) => None,

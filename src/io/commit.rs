@@ -89,10 +89,7 @@ pub fn write_set(files: &[(&Path, &[u8])], inputs: &[&Path]) -> Result<(), Write
         }
     };
     for (path, bytes) in files {
-        let target = folder_of(path)
-            .canonicalize()
-            .map(|d| d.join(path.file_name().unwrap_or_default()))
-            .unwrap_or_else(|_| path.to_path_buf());
+        let target = target_of(path);
         let tmp = temp_name(&folder_of(&target), "tmp");
         if let Err(cause) = stage(&tmp, &target, bytes) {
             let _ = std::fs::remove_file(&tmp);
@@ -137,7 +134,15 @@ pub fn write_set(files: &[(&Path, &[u8])], inputs: &[&Path]) -> Result<(), Write
 /// Writes `bytes` to the new file `tmp` with the permissions (and, where allowed, the owner)
 /// of `target` if it exists, and syncs it.
 fn stage(tmp: &Path, target: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let mut f = std::fs::OpenOptions::new()
+    let mut f = open_staged(tmp, target)?;
+    f.write_all(bytes)?;
+    f.sync_all()
+}
+
+/// Creates the new file `tmp` with the permissions (and, where allowed, the owner) of `target`
+/// if it exists.
+fn open_staged(tmp: &Path, target: &Path) -> std::io::Result<std::fs::File> {
+    let f = std::fs::OpenOptions::new()
         .write(true)
         .create_new(true)
         .open(tmp)?;
@@ -150,8 +155,83 @@ fn stage(tmp: &Path, target: &Path, bytes: &[u8]) -> std::io::Result<()> {
             let _ = std::os::unix::fs::fchown(&f, Some(old.uid()), Some(old.gid()));
         }
     }
-    f.write_all(bytes)?;
-    f.sync_all()
+    Ok(f)
+}
+
+/// The canonical target of an output path (its folder resolved, its name kept).
+fn target_of(path: &Path) -> PathBuf {
+    folder_of(path)
+        .canonicalize()
+        .map(|d| d.join(path.file_name().unwrap_or_default()))
+        .unwrap_or_else(|_| path.to_path_buf())
+}
+
+/// A single output written piece by piece into its temporary file while the run computes it
+/// (for output too long to hold in memory), then committed as a set of one file
+/// ([`write_set`]'s steps 1 and 3: same temporary name, permissions, held signals, recovery).
+/// Dropped without [`StreamedOutput::commit`] (an error, an early return), it removes its
+/// temporary file and leaves the old output as it was.
+pub struct StreamedOutput {
+    path: PathBuf,
+    target: PathBuf,
+    tmp: PathBuf,
+    file: std::io::BufWriter<std::fs::File>,
+    committed: bool,
+}
+
+impl StreamedOutput {
+    /// Checks `path` like every output ([`check_outputs`], `inputs` never replaced) and
+    /// creates its temporary file.
+    pub fn create(path: &Path, inputs: &[&Path]) -> Result<StreamedOutput, WriteError> {
+        check_outputs(&[path], inputs)?;
+        let target = target_of(path);
+        let tmp = temp_name(&folder_of(&target), "tmp");
+        let file = open_staged(&tmp, &target).map_err(|cause| {
+            let _ = std::fs::remove_file(&tmp);
+            WriteError::Io {
+                path: path.to_path_buf(),
+                cause,
+            }
+        })?;
+        Ok(StreamedOutput {
+            path: path.to_path_buf(),
+            target,
+            tmp,
+            file: std::io::BufWriter::with_capacity(1 << 16, file),
+            committed: false,
+        })
+    }
+
+    /// Where the content goes (buffered).
+    pub fn writer(&mut self) -> &mut std::io::BufWriter<std::fs::File> {
+        &mut self.file
+    }
+
+    /// Syncs the temporary file and renames it over the output.
+    pub fn commit(mut self) -> Result<(), WriteError> {
+        let io_err = |cause| WriteError::Io {
+            path: self.path.clone(),
+            cause,
+        };
+        self.file.flush().map_err(io_err)?;
+        self.file.get_ref().sync_all().map_err(io_err)?;
+        let folder = folder_of(&self.target);
+        let _one = COMMIT.lock().unwrap_or_else(|e| e.into_inner());
+        recover(&folder);
+        let _held = signals::Held::new();
+        std::fs::rename(&self.tmp, &self.target).map_err(io_err)?;
+        sync_folder(&folder);
+        self.committed = true;
+        Ok(())
+    }
+}
+
+impl Drop for StreamedOutput {
+    fn drop(&mut self) {
+        if !self.committed {
+            let _ = std::fs::remove_file(&self.tmp);
+        }
+    }
 }
 
 fn write_journals(

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 mod commit;
 pub mod read;
 
-pub use commit::{recover, write_set};
+pub use commit::{recover, write_set, StreamedOutput};
 pub use read::{read_input, read_input_text, track_inputs, FileId, ReadError};
 
 /// Errors of [`check_outputs`] and [`write_set`].

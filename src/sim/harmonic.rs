@@ -141,13 +141,7 @@ pub fn steady_circle(
     let h = period / samples_per_revolution as f64;
     let n = steady_samples(samples_per_revolution, revolutions);
     let (nu, ny) = (phasors.inputs.len(), phasors.outputs.len());
-    let mut run = Run {
-        t_s: Vec::with_capacity(n),
-        nu,
-        ny,
-        inputs: Vec::with_capacity(n * nu),
-        outputs: Vec::with_capacity(n * ny),
-    };
+    let mut run = Run::with_capacity(nu, ny, n);
     for k in 0..n {
         let t = k as f64 * h;
         let e = c64::cis(phasors.omega * t);

@@ -12,6 +12,7 @@
 
 pub mod harmonic;
 pub mod output;
+pub mod propagate;
 pub mod setpoint;
 
 use crate::control::{ClosedLoop, INPUTS_PER_AXIS};
@@ -71,6 +72,17 @@ pub struct Run {
 }
 
 impl Run {
+    /// An empty run with room for `samples` samples of `nu` inputs and `ny` outputs.
+    pub fn with_capacity(nu: usize, ny: usize, samples: usize) -> Run {
+        Run {
+            t_s: Vec::with_capacity(samples),
+            nu,
+            ny,
+            inputs: Vec::with_capacity(samples * nu),
+            outputs: Vec::with_capacity(samples * ny),
+        }
+    }
+
     /// Number of samples.
     pub fn len(&self) -> usize {
         self.t_s.len()
@@ -94,6 +106,13 @@ impl Run {
     /// The series of one named output, if the closed loop has it.
     pub fn output_series(&self, cl: &ClosedLoop, name: &str) -> Option<Vec<f64>> {
         Some(self.output(cl.output(name)?).collect())
+    }
+
+    /// Appends the samples of `other` (same inputs and outputs).
+    pub fn extend(&mut self, other: &Run) {
+        self.t_s.extend_from_slice(&other.t_s);
+        self.inputs.extend_from_slice(&other.inputs);
+        self.outputs.extend_from_slice(&other.outputs);
     }
 
     /// The series of one named input, if the closed loop has it.
@@ -135,68 +154,39 @@ pub fn simulate_discrete(
 }
 
 /// The time loop over pieces `(from_s, closed loop, discretisation)` sorted by start time: from
-/// rest in equilibrium at the first set point, the state carried across piece boundaries; no
-/// allocation per step.
+/// rest in equilibrium at the first set point, the state carried across piece boundaries
+/// ([`propagate`]: blocks of samples, matrix products over each block), collected into one run.
 fn run_piecewise(pieces: &[Piece], setpoint: &dyn SetPoint) -> Result<Run, SimError> {
-    let &(_, cl0, disc0, _) = pieces
-        .first()
-        .ok_or_else(|| SimError::Invalid("no segment to simulate".into()))?;
-    let h = disc0.step_s;
-    if pieces.iter().any(|p| p.2.step_s != h) {
-        return Err(SimError::Invalid(
-            "segments with different step sizes".into(),
-        ));
-    }
-    let steps = (setpoint.duration_s() / h).ceil();
-    if !(steps.is_finite() && steps < MAX_SAMPLES as f64) {
-        return Err(SimError::Invalid(format!(
-            "{:.4} s at {} Hz would be {} samples, at most {MAX_SAMPLES} are simulated (a lower rate or fewer revolutions)",
-            setpoint.duration_s(),
-            crate::text::num(1.0 / h),
-            crate::text::num(steps)
-        )));
-    }
-    let steps = steps as usize;
-    let (nu, nx, ny) = (cl0.b.ncols(), cl0.a.nrows(), cl0.c.nrows());
-    let mut u_now = DVector::zeros(nu);
-    let mut u_next = DVector::zeros(nu);
-    setpoint.eval(0.0, &cl0.axes, u_now.as_mut_slice());
-    let mut x = cl0.equilibrium(&u_now).ok_or(SimError::NoEquilibrium)?;
-    let mut x_next = DVector::zeros(nx);
-    let mut run = Run {
-        t_s: Vec::with_capacity(steps + 1),
-        nu,
-        ny,
-        inputs: Vec::with_capacity((steps + 1) * nu),
-        outputs: Vec::with_capacity((steps + 1) * ny),
-    };
-    let mut y = DVector::zeros(ny);
-    let mut active = 0;
-    for k in 0..=steps {
-        let t = k as f64 * h;
-        while active + 1 < pieces.len() && pieces[active + 1].0 <= t {
-            active += 1;
+    let mut run: Option<Run> = None;
+    propagate::run_blocks(pieces, setpoint, |block: &Run| -> Result<(), SimError> {
+        match &mut run {
+            None => {
+                let samples = (setpoint.duration_s() / pieces[0].2.step_s).ceil() as usize + 1;
+                let mut all = Run::with_capacity(block.nu, block.ny, samples);
+                all.extend(block);
+                run = Some(all);
+            }
+            Some(all) => all.extend(block),
         }
-        let (_, cl, disc, nest_origin) = pieces[active];
-        y.gemv(1.0, &cl.c, &x, 0.0);
-        y.gemv(1.0, &cl.d, &u_now, 1.0);
-        if let Some(origin) = nest_origin {
-            follow_the_tool(cl, origin, &x, &u_now, &mut y);
-        }
-        run.t_s.push(t);
-        run.inputs.extend_from_slice(u_now.as_slice());
-        run.outputs.extend_from_slice(y.as_slice());
-        if k == steps {
-            break;
-        }
-        setpoint.eval(t + h, &cl0.axes, u_next.as_mut_slice());
-        x_next.gemv(1.0, &disc.phi, &x, 0.0);
-        x_next.gemv(1.0, &disc.gamma0, &u_now, 1.0);
-        x_next.gemv(1.0, &disc.gamma1, &u_next, 1.0);
-        std::mem::swap(&mut x, &mut x_next);
-        std::mem::swap(&mut u_now, &mut u_next);
+        Ok(())
+    })?;
+    run.ok_or_else(|| SimError::Invalid("no samples simulated".into()))
+}
+
+/// As [`simulate`], handing the run to `sink` in blocks of at most
+/// [`propagate::BLOCK_SAMPLES`] samples as they are simulated (for output written while the
+/// simulation runs: memory independent of the run's length).
+pub fn simulate_blocks<E: From<SimError>>(
+    cl: &ClosedLoop,
+    setpoint: &dyn SetPoint,
+    rate_hz: f64,
+    sink: impl FnMut(&Run) -> Result<(), E>,
+) -> Result<(), E> {
+    if !(rate_hz.is_finite() && rate_hz > 0.0) {
+        return Err(SimError::Invalid(format!("sample rate {rate_hz} Hz must be > 0")).into());
     }
-    Ok(run)
+    let disc = Discrete::new(cl, 1.0 / rate_hz);
+    propagate::run_blocks(&[(0.0, cl, &disc, None)], setpoint, sink)
 }
 
 /// Most samples one simulation computes (bounds its memory: each sample holds every input
@@ -205,7 +195,7 @@ pub const MAX_SAMPLES: usize = 2_000_000;
 
 /// One stretch of a run: start time, closed loop, discretisation and, for a long move, the set
 /// position (axis order, m) at which the closed loop was assembled.
-type Piece<'a> = (f64, &'a ClosedLoop, &'a Discrete, Option<&'a [f64]>);
+pub(crate) type Piece<'a> = (f64, &'a ClosedLoop, &'a Discrete, Option<&'a [f64]>);
 
 /// The deviation at the point of the workpiece now under the tool: the closed loop's TCP
 /// outputs refer to the point under the TCP where it was assembled; since then the TCP has moved

@@ -45,6 +45,7 @@ impl Default for CsvOptions {
 }
 
 /// Column names and, per column, where its values come from.
+#[derive(Debug)]
 enum Source {
     Time,
     Output(usize, f64),
@@ -110,44 +111,90 @@ pub fn to_csv(cl: &ClosedLoop, run: &Run, opts: &CsvOptions) -> Vec<u8> {
         .correction
         .as_deref()
         .filter(|c| c.len() == run.inputs.len());
-    let cols = columns(cl, opts.required_only, corr.is_some());
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(opts.seed);
-    let noise = Normal::new(0.0, opts.noise_um * 1e-3)
-        .ok()
-        .filter(|_| opts.noise_um > 0.0);
-    let mut w = csv::Writer::from_writer(Vec::with_capacity(run.len() * cols.len() * 16));
+    let buffer = Vec::with_capacity(run.len() * 30 * 16);
     // Writing to memory cannot fail.
-    let _ = w.write_record(cols.iter().map(|(n, _)| n.as_str()));
-    let mut record = Vec::with_capacity(cols.len());
-    for k in 0..run.len() {
-        record.clear();
-        for (name, src) in &cols {
-            let mut v = match src {
-                Source::Time => run.t_s[k],
-                Source::Output(i, s) => run.outputs[k * run.ny + i] * s,
-                Source::Input(i, s) => {
-                    let c = corr.map_or(0.0, |c| c[k * run.nu + i]);
-                    (run.inputs[k * run.nu + i] - c) * s
-                }
-                Source::Correction(i, s) => corr.map_or(0.0, |c| c[k * run.nu + i]) * s,
-                Source::Zero => 0.0,
-            };
-            if let Some(n) = &noise {
-                if name.ends_with("_ext_mm") {
-                    v += n.sample(&mut rng);
-                }
-            }
-            let text = format!("{v:.*}", opts.decimals);
-            // A value that rounds to zero is written without a sign.
-            if text.starts_with('-') && text[1..].bytes().all(|c| c == b'0' || c == b'.') {
-                record.push(text[1..].to_string());
-            } else {
-                record.push(text);
-            }
-        }
-        let _ = w.write_record(&record);
+    let Ok(mut stream) = CsvStream::new(cl, opts, corr.is_some(), buffer) else {
+        return Vec::new();
+    };
+    let _ = stream.write(run, corr);
+    stream.finish().unwrap_or_default()
+}
+
+/// CSV output written block by block as a simulation runs ([`crate::sim::simulate_blocks`]):
+/// the same bytes as [`to_csv`] of the whole run, the noise drawn in the same order.
+pub struct CsvStream<W: std::io::Write> {
+    writer: csv::Writer<W>,
+    cols: Vec<(String, Source)>,
+    rng: rand_chacha::ChaCha8Rng,
+    noise: Option<Normal<f64>>,
+    decimals: usize,
+    record: Vec<String>,
+}
+
+impl<W: std::io::Write> CsvStream<W> {
+    /// Writes the header to `inner`; `compensated`: with the `<axis>_comp_mm` columns (the
+    /// corrections then come with every block). `opts.correction` is not used.
+    pub fn new(
+        cl: &ClosedLoop,
+        opts: &CsvOptions,
+        compensated: bool,
+        inner: W,
+    ) -> Result<Self, csv::Error> {
+        let cols = columns(cl, opts.required_only, compensated);
+        let mut writer = csv::Writer::from_writer(inner);
+        writer.write_record(cols.iter().map(|(n, _)| n.as_str()))?;
+        Ok(CsvStream {
+            writer,
+            rng: rand_chacha::ChaCha8Rng::seed_from_u64(opts.seed),
+            noise: Normal::new(0.0, opts.noise_um * 1e-3)
+                .ok()
+                .filter(|_| opts.noise_um > 0.0),
+            decimals: opts.decimals,
+            record: Vec::with_capacity(cols.len()),
+            cols,
+        })
     }
-    w.into_inner().unwrap_or_default()
+
+    /// Writes the samples of `run`; `correction` (laid out like [`Run::inputs`]) is the
+    /// compensation added to its set points.
+    pub fn write(&mut self, run: &Run, correction: Option<&[f64]>) -> Result<(), csv::Error> {
+        for k in 0..run.len() {
+            self.record.clear();
+            for (name, src) in &self.cols {
+                let mut v = match src {
+                    Source::Time => run.t_s[k],
+                    Source::Output(i, s) => run.outputs[k * run.ny + i] * s,
+                    Source::Input(i, s) => {
+                        let c = correction.map_or(0.0, |c| c[k * run.nu + i]);
+                        (run.inputs[k * run.nu + i] - c) * s
+                    }
+                    Source::Correction(i, s) => correction.map_or(0.0, |c| c[k * run.nu + i]) * s,
+                    Source::Zero => 0.0,
+                };
+                if let Some(n) = &self.noise {
+                    if name.ends_with("_ext_mm") {
+                        v += n.sample(&mut self.rng);
+                    }
+                }
+                let text = format!("{v:.*}", self.decimals);
+                // A value that rounds to zero is written without a sign.
+                if text.starts_with('-') && text[1..].bytes().all(|c| c == b'0' || c == b'.') {
+                    self.record.push(text[1..].to_string());
+                } else {
+                    self.record.push(text);
+                }
+            }
+            self.writer.write_record(&self.record)?;
+        }
+        Ok(())
+    }
+
+    /// Flushes and returns the writer.
+    pub fn finish(self) -> Result<W, std::io::Error> {
+        self.writer
+            .into_inner()
+            .map_err(|e| std::io::Error::other(e.to_string()))
+    }
 }
 
 /// The run as an in-memory R-Test series (internal = linear scales, external = TCP relative to
