@@ -88,6 +88,11 @@ impl FrequencyForm {
         FrequencyForm { h, qt_b, c_q, d }
     }
 
+    /// The upper Hessenberg matrix H, similar to A (the same eigenvalues).
+    pub fn hessenberg(&self) -> faer::MatRef<'_, f64> {
+        self.h.as_ref()
+    }
+
     /// Output phasors Y = C (jωI − A)⁻¹ B U + D U of input phasors `u`; `None` if jωI − A is
     /// singular (a pole on the imaginary axis at ω) or the result is not finite.
     pub fn response(&self, omega: f64, u: &[c64]) -> Option<Vec<c64>> {

@@ -12,6 +12,7 @@ use super::normalise::Normalised;
 use super::{evaluate, iso230, CircleResult, CircleSeries, EvalOptions};
 use crate::axes::{Direction, Eij, Plane};
 use crate::rtest::json::{CircleJson, TestJson, TimeOffsetJson};
+use rayon::prelude::*;
 
 mod clocks;
 use clocks::{align_clock, lag_of_clock};
@@ -138,22 +139,27 @@ pub(super) fn group_key(input: &TestInput, norm: &Normalised) -> String {
 
 /// Reads, aligns and evaluates `inputs` (see the module docs).
 pub fn evaluate_tests(inputs: &[TestInput], opts: &SuiteOptions) -> Result<Suite, RtestError> {
-    let mut prepared = Vec::with_capacity(inputs.len());
-    for input in inputs {
-        let (eval, source) = eval_options(input, opts);
-        let data = match &input.recording {
-            Recording::Single(_) => Data::Single(input.read_single()?),
-            Recording::Split { internal, external } => Data::Split {
-                internal: Record::read_internal(internal, &input.internal_columns)?,
-                external: Record::read_external(external, &input.external_columns)?,
-            },
-        };
-        prepared.push(Prepared {
-            opts: eval,
-            source,
-            data,
-        });
-    }
+    // Files are read and evaluated in parallel; the first error in input order is reported.
+    let prepared: Vec<Prepared> = inputs
+        .par_iter()
+        .map(|input| -> Result<Prepared, RtestError> {
+            let (eval, source) = eval_options(input, opts);
+            let data = match &input.recording {
+                Recording::Single(_) => Data::Single(input.read_single()?),
+                Recording::Split { internal, external } => Data::Split {
+                    internal: Record::read_internal(internal, &input.internal_columns)?,
+                    external: Record::read_external(external, &input.external_columns)?,
+                },
+            };
+            Ok(Prepared {
+                opts: eval,
+                source,
+                data,
+            })
+        })
+        .collect::<Vec<_>>()
+        .into_iter()
+        .collect::<Result<_, _>>()?;
     // Clock groups, in order of first appearance; single-file and two-system tests apart.
     let mut groups: Vec<(String, bool, Vec<usize>)> = Vec::new();
     for (i, (input, p)) in inputs.iter().zip(&prepared).enumerate() {
@@ -176,10 +182,22 @@ pub fn evaluate_tests(inputs: &[TestInput], opts: &SuiteOptions) -> Result<Suite
         };
         clocks.extend(report);
     }
+    let evaluated: Vec<(CircleSeries, CircleResult)> = inputs
+        .par_iter()
+        .zip(&prepared)
+        .zip(&offsets)
+        .map(|((input, p), offset)| {
+            let series = series_at(input, &p.data, offset.as_ref().map(|o| o.offset_ms * 1e-3))?;
+            let result = evaluate(&series, &p.opts)?;
+            Ok((series, result))
+        })
+        .collect::<Vec<_>>()
+        .into_iter()
+        .collect::<Result<_, RtestError>>()?;
     let mut tests = Vec::with_capacity(inputs.len());
-    for ((input, p), offset) in inputs.iter().zip(prepared).zip(offsets) {
-        let series = series_at(input, &p.data, offset.as_ref().map(|o| o.offset_ms * 1e-3))?;
-        let mut result = evaluate(&series, &p.opts)?;
+    for (((input, p), offset), (series, mut result)) in
+        inputs.iter().zip(prepared).zip(offsets).zip(evaluated)
+    {
         let mut notes = condition_warnings(input, &result, p.source);
         if let Some(o) = offset
             .as_ref()
