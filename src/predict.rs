@@ -119,7 +119,9 @@ pub struct SimSettings {
     pub rate_hz: f64,
     /// Steady revolutions per simulated test (4).
     pub revolutions: u32,
-    /// Samples per revolution of the harmonic steady state (128).
+    /// Samples per revolution of the harmonic steady state (128): nothing is sampled, but the
+    /// closed-form evaluation reproduces the evaluation of this many samples per revolution
+    /// (the phase slope's share of the internal path's ripple depends on it).
     pub harmonic_samples_per_revolution: usize,
     /// Axis positions of the circle centre for tests that give none, m (machine axis order;
     /// `None`: the machine's reference position).

@@ -30,7 +30,8 @@ impl Method {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Settings {
     /// How the tests are simulated inside the optimisation ([`SimSettings::default`]: harmonic
-    /// steady state, 4 steady revolutions, 128 samples per revolution; time domain at 1 kHz).
+    /// steady state evaluated in closed form as 4 steady revolutions of 128 samples; time domain
+    /// at 1 kHz).
     pub simulation: SimSettings,
     /// Lower bound of every factor (0.01).
     pub min_factor: f64,
