@@ -674,26 +674,7 @@ fn output_that_is_a_folder_or_an_input_is_refused() {
     std::fs::create_dir_all(&dir).unwrap();
     let folder = format!("{dir}: is a folder, not a file");
     let clobber = format!("{m}: refusing to overwrite an input file");
-    let sim = |out: &str| -> Vec<String> {
-        [
-            "simulate",
-            "circle",
-            "--machine",
-            &m,
-            "--plane",
-            "zx",
-            "--radius-mm",
-            "2",
-            "--accel-m-s2",
-            "5",
-            "--direction",
-            "ccw",
-            "--out",
-            out,
-        ]
-        .map(String::from)
-        .to_vec()
-    };
+    let sim = |out: &str| common::circle_args(&m, out);
     let map_args = |out: &str| -> Vec<String> {
         [
             "map",

@@ -33,24 +33,7 @@ fn ok(args: &[&str]) {
 }
 
 fn circle(out: &str, machine: &str) -> Vec<String> {
-    [
-        "simulate",
-        "circle",
-        "--machine",
-        machine,
-        "--plane",
-        "zx",
-        "--radius-mm",
-        "2",
-        "--accel-m-s2",
-        "5",
-        "--direction",
-        "ccw",
-        "--out",
-        out,
-    ]
-    .map(String::from)
-    .to_vec()
+    common::circle_args(machine, out)
 }
 
 fn identify(s: &Scratch, machine: &str, measured: &str, extra: &[&str]) -> Vec<String> {

@@ -158,3 +158,26 @@ pub fn run(args: &[&str]) -> Run {
         stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
     }
 }
+
+/// `eij simulate circle` of the zx circle r = 2 mm, 5 m/s², ccw on `machine`, written to `out`:
+/// the arguments, for tests that add their own options.
+pub fn circle_args(machine: &str, out: &str) -> Vec<String> {
+    [
+        "simulate",
+        "circle",
+        "--machine",
+        machine,
+        "--plane",
+        "zx",
+        "--radius-mm",
+        "2",
+        "--accel-m-s2",
+        "5",
+        "--direction",
+        "ccw",
+        "--out",
+        out,
+    ]
+    .map(String::from)
+    .to_vec()
+}
