@@ -7,6 +7,7 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use eij::axes::{Direction, Plane};
+use eij::control::stability::Certificate;
 use eij::control::{ClosedLoop, FrequencyForm};
 use eij::machine::Machine;
 use eij::mbs::{modal, Model};
@@ -225,6 +226,15 @@ fn harmonic_circle(c: &mut Criterion, name: &str, cl: &ClosedLoop) {
                 .unwrap()
         })
     });
+    if let Some(cert) = Certificate::new(&cl.a) {
+        group.bench_function(
+            "stability certificate: made (eigen-decomposition + P)",
+            |b| b.iter(|| Certificate::new(black_box(&cl.a))),
+        );
+        group.bench_function("stability certificate: a loop checked against it", |b| {
+            b.iter(|| black_box(&cert).certifies(black_box(&cl.a)))
+        });
+    }
     group.finish();
 }
 

@@ -27,7 +27,7 @@
 //! ```
 
 use crate::axes::{Direction, Eij, Plane};
-use crate::control::{ClosedLoop, ControlError, FrequencyForm};
+use crate::control::{ClosedLoop, ControlError, FrequencyForm, NearbyCertificate};
 use crate::machine::Machine;
 use crate::mbs::MbsError;
 use crate::rtest::{self, EvalOptions, RtestError};
@@ -35,6 +35,7 @@ use crate::sim::setpoint::Circle;
 use crate::sim::{harmonic, output, simulate_discrete, Discrete, SimError};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
+use std::sync::Arc;
 
 /// EIJ of one test by parameter, µm·s²/m.
 pub type EijMap = BTreeMap<Eij, f64>;
@@ -222,6 +223,9 @@ pub struct Prediction {
     poses: Vec<Vec<f64>>,
     /// Index into `poses` per test.
     test_pose: Vec<usize>,
+    /// Per circle centre, the stability certificate of the latest closed loop checked in full
+    /// there (the loops of a Jacobian are checked against it).
+    certificates: Arc<Vec<NearbyCertificate>>,
 }
 
 impl Prediction {
@@ -272,11 +276,13 @@ impl Prediction {
             };
             test_pose.push(i);
         }
+        let certificates = Arc::new(poses.iter().map(|_| NearbyCertificate::default()).collect());
         Ok(Prediction {
             tests,
             settings,
             poses,
             test_pose,
+            certificates,
         })
     }
 
@@ -313,13 +319,14 @@ impl Prediction {
         let loops: Vec<Result<(ClosedLoop, Prepared), PredictError>> = (0..machines.len() * np)
             .into_par_iter()
             .map(|k| {
-                let cl = ClosedLoop::new(&machines[k / np], &self.poses[k % np]).map_err(|e| {
-                    PredictError::Simulation {
+                let (m, p) = (&machines[k / np], k % np);
+                let cl = ClosedLoop::new_near(m, &self.poses[p], &self.certificates[p]).map_err(
+                    |e| PredictError::Simulation {
                         test: "closed loop".into(),
                         machine: k / np,
                         source: e.into(),
-                    }
-                })?;
+                    },
+                )?;
                 let prepared = match solver {
                     SolverKind::Time => {
                         Prepared::Time(Discrete::new(&cl, 1.0 / self.settings.rate_hz))

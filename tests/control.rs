@@ -267,3 +267,104 @@ fn hessenberg_frequency_response_equals_a_dense_solve() {
         assert!(diff < 1e-10 * scale, "ω = {omega}: {diff:e} of {scale:e}");
     }
 }
+
+/// The largest real part of `a`'s eigenvalues, by nalgebra's real Schur form (with an
+/// iteration cap: independent of faer's eigen-solver that the stability check uses).
+fn spectral_abscissa(a: &DMatrix<f64>) -> f64 {
+    let schur = a.clone().try_schur(1e-14, 100_000).expect("Schur form");
+    let t = schur.unpack().1;
+    let n = t.nrows();
+    let mut worst = f64::NEG_INFINITY;
+    let mut i = 0;
+    while i < n {
+        if i + 1 < n && t[(i + 1, i)] != 0.0 {
+            // A 2×2 block: the real part of its complex pair is half its trace.
+            worst = worst.max(0.5 * (t[(i, i)] + t[(i + 1, i + 1)]));
+            i += 2;
+        } else {
+            worst = worst.max(t[(i, i)]);
+            i += 1;
+        }
+    }
+    worst
+}
+
+/// The Lyapunov certificate of a stable loop proves the loops of a finite-difference step
+/// around it stable, proves nothing for a loop far away (that one is checked in full, and
+/// stays stable), and never proves an unstable loop stable — even one just across the
+/// stability limit from the loop it was made from. `ClosedLoop::new_near` always gives the
+/// verdict of `ClosedLoop::new`.
+#[test]
+fn stability_certificate_proves_nearby_loops_and_never_an_unstable_one() {
+    use eij::control::stability::Certificate;
+    use eij::control::NearbyCertificate;
+    use eij::machine::Reduction;
+    use eij::mbs::Model;
+    let demo = load("demo-vmc.toml");
+    let pose = demo.reference_pose();
+    let state_matrix =
+        |m: &Machine| ClosedLoop::from_model(m, Model::assemble(m, &pose).unwrap()).a;
+    let with_factor = |f: f64| {
+        let mut m = demo.clone();
+        m.set_reduction(0, Reduction::GuidewayNormal, f).unwrap();
+        m
+    };
+    let cert = Certificate::new(&state_matrix(&demo)).expect("the demo's loop is strictly stable");
+    for f in [0.999, 1.001] {
+        let a = state_matrix(&with_factor(f));
+        assert!(spectral_abscissa(&a) < -1.0);
+        assert!(cert.certifies(&a), "a 1e-3 step of x.guideway_normal");
+    }
+    let far = state_matrix(&with_factor(0.3));
+    assert!(
+        spectral_abscissa(&far) < -1.0,
+        "stable, but far from the certificate's loop"
+    );
+    assert!(!cert.certifies(&far));
+    let near = NearbyCertificate::default();
+    assert!(ClosedLoop::new_near(&with_factor(0.3), &pose, &near).is_ok());
+
+    // The single-axis drive's proportional gain up to its stability limit (bisection on the
+    // full check), and the certificates of loops just inside it against loops just outside.
+    let text = std::fs::read_to_string(common::root().join("machines/reference/single-axis.toml"))
+        .unwrap();
+    let with_kp = |kp: f64| {
+        let t = text.replace("kp_nm_s_per_rad = 2.0", &format!("kp_nm_s_per_rad = {kp}"));
+        Machine::from_toml_str(&t, "kp.toml").unwrap()
+    };
+    let stable = |kp: f64| ClosedLoop::new(&with_kp(kp), &[0.0]).is_ok();
+    let (mut lo, mut hi) = (2.0, 2000.0);
+    assert!(stable(lo) && !stable(hi));
+    for _ in 0..60 {
+        let mid = (lo * hi).sqrt();
+        if stable(mid) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let a_of = |kp: f64| {
+        ClosedLoop::from_model(&with_kp(kp), Model::assemble(&with_kp(kp), &[0.0]).unwrap()).a
+    };
+    for inside in [lo, lo * (1.0 - 1e-6), lo * (1.0 - 1e-3)] {
+        let Some(cert) = Certificate::new(&a_of(inside)) else {
+            continue;
+        };
+        for outside in [hi, hi * (1.0 + 1e-6), hi * (1.0 + 1e-3), 2000.0] {
+            assert!(spectral_abscissa(&a_of(outside)) > 0.0 || !stable(outside));
+            assert!(
+                !cert.certifies(&a_of(outside)),
+                "kp {inside} certified kp {outside}"
+            );
+        }
+    }
+    for kp in [lo, hi, 2000.0, 2.0] {
+        let near = NearbyCertificate::default();
+        near.renew(&a_of(lo * (1.0 - 1e-3)));
+        assert_eq!(
+            ClosedLoop::new_near(&with_kp(kp), &[0.0], &near).is_ok(),
+            stable(kp),
+            "kp {kp}"
+        );
+    }
+}
