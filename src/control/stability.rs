@@ -97,12 +97,15 @@ impl NearbyCertificate {
         cert.is_some_and(|c| c.certifies(a))
     }
 
-    /// Stores the certificate of `a` (a loop just found stable), if one can be made.
-    pub fn renew(&self, a: &DMatrix<f64>) {
-        if let Some(c) = Certificate::new(a) {
-            if let Ok(mut slot) = self.0.lock() {
-                *slot = Some(Arc::new(c));
-            }
+    /// Makes the certificate of `a` and stores it; false when none can be made (`a` is not
+    /// proven stable: the eigenvalues must decide).
+    pub fn renew(&self, a: &DMatrix<f64>) -> bool {
+        let Some(c) = Certificate::new(a) else {
+            return false;
+        };
+        if let Ok(mut slot) = self.0.lock() {
+            *slot = Some(Arc::new(c));
         }
+        true
     }
 }
