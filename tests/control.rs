@@ -360,6 +360,10 @@ fn stability_certificate_proves_nearby_loops_and_never_an_unstable_one() {
     }
     for kp in [lo, hi, 2000.0, 2.0] {
         let near = NearbyCertificate::default();
+        assert!(
+            !near.renew(&a_of(lo * 0.9)),
+            "the first visit makes no certificate"
+        );
         assert!(near.renew(&a_of(lo * (1.0 - 1e-3))));
         assert_eq!(
             ClosedLoop::new_near(&with_kp(kp), &[0.0], &near).is_ok(),

@@ -110,7 +110,7 @@ impl ClosedLoop {
         let model = Model::assemble(machine, pose_m)?;
         modal::check_support(&model, machine)?;
         let cl = ClosedLoop::from_model(machine, model);
-        // The loop's own certificate, when one can be made, proves it stable as well (the
+        // The loop's own certificate, when one is made, proves it stable as well (the
         // eigenvalue check then decides only where no certificate proves anything).
         if !near.certifies(&cl.a) && !near.renew(&cl.a) {
             cl.check_stability(machine)?;

@@ -86,25 +86,44 @@ impl Certificate {
 
 /// The certificate of the latest closed loop checked in full at one circle centre, shared by
 /// the closed loops built there afterwards (in parallel; which certificate a loop meets never
-/// changes its verdict, only what the check costs).
+/// changes its verdict, only what the check costs). The first loop at a centre is checked by
+/// its eigenvalues alone: a certificate costs about twice that and pays only where more loops
+/// follow (a Jacobian's, not a map's one loop per grid point).
 #[derive(Debug, Default)]
-pub struct NearbyCertificate(Mutex<Option<Arc<Certificate>>>);
+pub struct NearbyCertificate(Mutex<Slot>);
+
+/// What a [`NearbyCertificate`] holds.
+#[derive(Debug, Default)]
+struct Slot {
+    /// Whether a loop was checked here before.
+    visited: bool,
+    /// The latest certificate made here.
+    certificate: Option<Arc<Certificate>>,
+}
 
 impl NearbyCertificate {
     /// Whether the stored certificate proves `a` stable.
     pub fn certifies(&self, a: &DMatrix<f64>) -> bool {
-        let cert = self.0.lock().ok().and_then(|c| c.clone());
+        let cert = self.0.lock().ok().and_then(|c| c.certificate.clone());
         cert.is_some_and(|c| c.certifies(a))
     }
 
-    /// Makes the certificate of `a` and stores it; false when none can be made (`a` is not
-    /// proven stable: the eigenvalues must decide).
+    /// For a loop the stored certificate does not prove: on the first visit nothing (false);
+    /// afterwards makes `a`'s own certificate and stores it, true when one can be made (it
+    /// proves `a` stable; else the eigenvalues must decide).
     pub fn renew(&self, a: &DMatrix<f64>) -> bool {
+        let first = self
+            .0
+            .lock()
+            .map(|mut s| !std::mem::replace(&mut s.visited, true));
+        if first.unwrap_or(true) {
+            return false;
+        }
         let Some(c) = Certificate::new(a) else {
             return false;
         };
         if let Ok(mut slot) = self.0.lock() {
-            *slot = Some(Arc::new(c));
+            slot.certificate = Some(Arc::new(c));
         }
         true
     }
