@@ -675,23 +675,7 @@ fn output_that_is_a_folder_or_an_input_is_refused() {
     let folder = format!("{dir}: is a folder, not a file");
     let clobber = format!("{m}: refusing to overwrite an input file");
     let sim = |out: &str| common::circle_args(&m, out);
-    let map_args = |out: &str| -> Vec<String> {
-        [
-            "map",
-            "--machine",
-            &m,
-            "--plane",
-            "zx",
-            "--accel-m-s2",
-            "5",
-            "--grid",
-            "x=0:1:2",
-            "--out",
-            out,
-        ]
-        .map(String::from)
-        .to_vec()
-    };
+    let map_args = |out: &str| common::map_args(&m, out);
     let export = |out: &str| -> Vec<String> {
         ["export", "--machine", &m, "--out", out]
             .map(String::from)

@@ -65,19 +65,7 @@ fn strs(v: &[String]) -> Vec<&str> {
 /// `eij map` of the demo into `map.csv` (three points along x): its text and last row.
 fn demo_map(s: &Scratch) -> (String, String) {
     let mp = s.s("map.csv");
-    ok(&[
-        "map",
-        "--machine",
-        DEMO,
-        "--plane",
-        "zx",
-        "--accel-m-s2",
-        "5",
-        "--grid",
-        "x=0:1:2",
-        "--out",
-        &mp,
-    ]);
+    ok(&strs(&common::map_args(DEMO, &mp)));
     let text = std::fs::read_to_string(&mp).unwrap();
     let last = text.lines().last().unwrap().to_string();
     (text, last)
@@ -200,22 +188,9 @@ fn no_output_replaces_a_file_read_directly_or_indirectly() {
         &clobber,
     );
     let mp = s.s("map.csv");
-    let map = [
-        "map",
-        "--machine",
-        &m,
-        "--plane",
-        "zx",
-        "--accel-m-s2",
-        "5",
-        "--grid",
-        "x=0:1:2",
-        "--out",
-        &mp,
-        "--plot",
-        &cat,
-    ];
-    refused(&s, &map, &clobber);
+    let mut map = common::map_args(&m, &mp);
+    map.extend(["--plot".to_string(), cat.clone()]);
+    refused(&s, &strs(&map), &clobber);
     let args = identify(&s, &m, ZX_CSV, &["--stiffness-out", &cat]);
     refused(&s, &strs(&args), &clobber);
     // A hard link to an input is the input.

@@ -181,3 +181,23 @@ pub fn circle_args(machine: &str, out: &str) -> Vec<String> {
     .map(String::from)
     .to_vec()
 }
+
+/// `eij map` of plane zx at 5 m/s² on three points along x (0, 1, 2 mm) of `machine`, written
+/// to `out`: the arguments, for tests that add their own options.
+pub fn map_args(machine: &str, out: &str) -> Vec<String> {
+    [
+        "map",
+        "--machine",
+        machine,
+        "--plane",
+        "zx",
+        "--accel-m-s2",
+        "5",
+        "--grid",
+        "x=0:1:2",
+        "--out",
+        out,
+    ]
+    .map(String::from)
+    .to_vec()
+}
