@@ -5,6 +5,7 @@
 use std::path::{Path, PathBuf};
 
 mod commit;
+pub mod delimited;
 pub mod read;
 
 pub use commit::{recover, write_set, StreamedOutput};
