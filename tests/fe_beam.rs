@@ -40,7 +40,14 @@ fn rel(a: f64, b: f64) -> f64 {
 fn cantilever_tip_deflection_with_shear_in_both_planes() {
     // Along machine z, local y = machine x: a force along x bends about local z (I_z).
     let (b, h, l) = (0.12, 0.08, 0.9);
-    let bm = beam([0.0, 0.6, -0.1], [0.0, 0.6, -0.1 + l], [1.0, 0.0, 0.0], b, h, 6);
+    let bm = beam(
+        [0.0, 0.6, -0.1],
+        [0.0, 0.6, -0.1 + l],
+        [1.0, 0.0, 0.0],
+        b,
+        h,
+        6,
+    );
     let model = FeModel::beam(&bm).unwrap();
     let k = dense(&model.stiffness);
     let n = model.n_dofs();
@@ -51,7 +58,11 @@ fn cantilever_tip_deflection_with_shear_in_both_planes() {
         f[tip + dir] = p;
         let u = static_solve(&k, &f, &(0..6).collect::<Vec<_>>());
         let expected = p * l.powi(3) / (3.0 * E * i) + p * l / (KAPPA * G * b * h);
-        assert!(rel(u[tip + dir], expected) < 1e-9, "dir {dir}: {} vs {expected}", u[tip + dir]);
+        assert!(
+            rel(u[tip + dir], expected) < 1e-9,
+            "dir {dir}: {} vs {expected}",
+            u[tip + dir]
+        );
         // Tip rotation of a cantilever under a tip force: P L² / (2EI), about the axis ⟂ both.
         let rot = if dir == 0 { tip + 4 } else { tip + 3 };
         let sign = if dir == 0 { 1.0 } else { -1.0 };
@@ -66,7 +77,9 @@ fn cantilever_tip_deflection_with_shear_in_both_planes() {
 
 /// Nearest value of `list` to `x`, relative distance.
 fn nearest(list: &[f64], x: f64) -> f64 {
-    list.iter().map(|v| rel(*v, x)).fold(f64::INFINITY, f64::min)
+    list.iter()
+        .map(|v| rel(*v, x))
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// Lowest frequencies (Hz) of the beam held at `fixed` (dense solve).
@@ -74,7 +87,10 @@ fn frequencies(model: &FeModel, fixed: &[usize]) -> Vec<f64> {
     let keep: Vec<usize> = (0..model.n_dofs()).filter(|i| !fixed.contains(i)).collect();
     let k = sub(&dense(&model.stiffness), &keep);
     let m = sub(&dense(&model.mass), &keep);
-    generalized_eigenvalues(&k, &m).into_iter().map(hz).collect()
+    generalized_eigenvalues(&k, &m)
+        .into_iter()
+        .map(hz)
+        .collect()
 }
 
 #[test]
@@ -91,7 +107,10 @@ fn slender_cantilever_bending_and_torsion_frequencies() {
     }
     let ip = bm.iy_m4 + bm.iz_m4;
     let torsion = PI / (2.0 * l) * (G * bm.torsion_m4 / (RHO * ip)).sqrt() / (2.0 * PI);
-    assert!(nearest(&f, torsion) < 5e-3, "torsion {torsion} Hz not in {f:?}");
+    assert!(
+        nearest(&f, torsion) < 5e-3,
+        "torsion {torsion} Hz not in {f:?}"
+    );
     // The sparse Lanczos path finds the same lowest modes as the dense solve.
     let modes = lowest_modes(&model, &(0..6).collect::<Vec<_>>(), 0.0, 6).unwrap();
     for (x, y) in modes.frequencies_hz().iter().zip(&f) {
@@ -124,8 +143,14 @@ fn stocky_simply_supported_beam_matches_timoshenko_not_euler_bernoulli() {
     for i in [bm.iy_m4, bm.iz_m4] {
         let timo = timoshenko_simply_supported(i, a, l);
         let eb = PI * PI / (l * l) * (E * i / (RHO * a)).sqrt() / (2.0 * PI);
-        assert!(eb / timo > 1.04, "the beam must be stocky enough to tell the theories apart");
-        assert!(nearest(&f, timo) < 5e-3, "Timoshenko {timo} Hz not in {f:?}");
+        assert!(
+            eb / timo > 1.04,
+            "the beam must be stocky enough to tell the theories apart"
+        );
+        assert!(
+            nearest(&f, timo) < 5e-3,
+            "Timoshenko {timo} Hz not in {f:?}"
+        );
         assert!(nearest(&f, eb) > 3e-2);
     }
 }
@@ -133,37 +158,74 @@ fn stocky_simply_supported_beam_matches_timoshenko_not_euler_bernoulli() {
 /// Textbook shear-deformable element (Przemieniecki) for (v₁, θ₁, v₂, θ₂), θ = dv/dx.
 fn textbook(l: f64, ei: f64, phi: f64, rho_a: f64, rho_i: f64) -> (DMatrix<f64>, DMatrix<f64>) {
     let c = ei / ((1.0 + phi) * l.powi(3));
-    let k = DMatrix::from_row_slice(4, 4, &[
-        12.0, 6.0 * l, -12.0, 6.0 * l,
-        6.0 * l, (4.0 + phi) * l * l, -6.0 * l, (2.0 - phi) * l * l,
-        -12.0, -6.0 * l, 12.0, -6.0 * l,
-        6.0 * l, (2.0 - phi) * l * l, -6.0 * l, (4.0 + phi) * l * l,
-    ]) * c;
+    let k = DMatrix::from_row_slice(
+        4,
+        4,
+        &[
+            12.0,
+            6.0 * l,
+            -12.0,
+            6.0 * l,
+            6.0 * l,
+            (4.0 + phi) * l * l,
+            -6.0 * l,
+            (2.0 - phi) * l * l,
+            -12.0,
+            -6.0 * l,
+            12.0,
+            -6.0 * l,
+            6.0 * l,
+            (2.0 - phi) * l * l,
+            -6.0 * l,
+            (4.0 + phi) * l * l,
+        ],
+    ) * c;
     let d = (1.0 + phi).powi(2);
-    let (m11, m12) = (13.0 / 35.0 + 7.0 / 10.0 * phi + phi * phi / 3.0, (11.0 / 210.0 + 11.0 / 120.0 * phi + phi * phi / 24.0) * l);
-    let (m13, m14) = (9.0 / 70.0 + 3.0 / 10.0 * phi + phi * phi / 6.0, -(13.0 / 420.0 + 3.0 / 40.0 * phi + phi * phi / 24.0) * l);
-    let (m22, m24) = ((1.0 / 105.0 + phi / 60.0 + phi * phi / 120.0) * l * l, -(1.0 / 140.0 + phi / 60.0 + phi * phi / 120.0) * l * l);
-    let mt = DMatrix::from_row_slice(4, 4, &[
-        m11, m12, m13, m14,
-        m12, m22, -m14, m24,
-        m13, -m14, m11, -m12,
-        m14, m24, -m12, m22,
-    ]) * (rho_a * l / d);
+    let (m11, m12) = (
+        13.0 / 35.0 + 7.0 / 10.0 * phi + phi * phi / 3.0,
+        (11.0 / 210.0 + 11.0 / 120.0 * phi + phi * phi / 24.0) * l,
+    );
+    let (m13, m14) = (
+        9.0 / 70.0 + 3.0 / 10.0 * phi + phi * phi / 6.0,
+        -(13.0 / 420.0 + 3.0 / 40.0 * phi + phi * phi / 24.0) * l,
+    );
+    let (m22, m24) = (
+        (1.0 / 105.0 + phi / 60.0 + phi * phi / 120.0) * l * l,
+        -(1.0 / 140.0 + phi / 60.0 + phi * phi / 120.0) * l * l,
+    );
+    let mt = DMatrix::from_row_slice(
+        4,
+        4,
+        &[
+            m11, m12, m13, m14, m12, m22, -m14, m24, m13, -m14, m11, -m12, m14, m24, -m12, m22,
+        ],
+    ) * (rho_a * l / d);
     let (r11, r12) = (6.0 / 5.0, (1.0 / 10.0 - phi / 2.0) * l);
-    let (r22, r24) = ((2.0 / 15.0 + phi / 6.0 + phi * phi / 3.0) * l * l, (-1.0 / 30.0 - phi / 6.0 + phi * phi / 6.0) * l * l);
-    let mr = DMatrix::from_row_slice(4, 4, &[
-        r11, r12, -r11, r12,
-        r12, r22, -r12, r24,
-        -r11, -r12, r11, -r12,
-        r12, r24, -r12, r22,
-    ]) * (rho_i / (l * d));
+    let (r22, r24) = (
+        (2.0 / 15.0 + phi / 6.0 + phi * phi / 3.0) * l * l,
+        (-1.0 / 30.0 - phi / 6.0 + phi * phi / 6.0) * l * l,
+    );
+    let mr = DMatrix::from_row_slice(
+        4,
+        4,
+        &[
+            r11, r12, -r11, r12, r12, r22, -r12, r24, -r11, -r12, r11, -r12, r12, r24, -r12, r22,
+        ],
+    ) * (rho_i / (l * d));
     (k, mt + mr)
 }
 
 #[test]
 fn two_element_beam_equals_hand_assembly() {
     let (b, h, le) = (0.1, 0.06, 0.3);
-    let bm = beam([0.0, 0.0, 0.0], [2.0 * le, 0.0, 0.0], [0.0, 1.0, 0.0], b, h, 2);
+    let bm = beam(
+        [0.0, 0.0, 0.0],
+        [2.0 * le, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        b,
+        h,
+        2,
+    );
     let model = FeModel::beam(&bm).unwrap();
     let (a, asr) = (b * h, KAPPA * b * h);
     let mut k = DMatrix::<f64>::zeros(18, 18);
@@ -199,8 +261,16 @@ fn two_element_beam_equals_hand_assembly() {
         put(&[2, 4, 8, 10], &(&s * kb * &s), &(&s * mb * &s));
     }
     let (kf, mf) = (dense(&model.stiffness), dense(&model.mass));
-    assert!((&kf - &k).amax() <= 1e-12 * k.amax(), "K differs by {}", (&kf - &k).amax());
-    assert!((&mf - &m).amax() <= 1e-12 * m.amax(), "M differs by {}", (&mf - &m).amax());
+    assert!(
+        (&kf - &k).amax() <= 1e-12 * k.amax(),
+        "K differs by {}",
+        (&kf - &k).amax()
+    );
+    assert!(
+        (&mf - &m).amax() <= 1e-12 * m.amax(),
+        "M differs by {}",
+        (&mf - &m).amax()
+    );
 }
 
 #[test]
@@ -216,6 +286,11 @@ fn beam_mass_properties_are_those_of_the_bar() {
     let ip = RHO * (bm.iy_m4 + bm.iz_m4) * l;
     assert!(rel(mp.inertia_kg_m2[(2, 2)], ip) < 1e-9);
     // About machine x (local y): m L²/12 + ρ I_y L (rotary inertia of the section).
-    assert!(rel(mp.inertia_kg_m2[(0, 0)], mass * l * l / 12.0 + RHO * bm.iy_m4 * l) < 1e-9);
+    assert!(
+        rel(
+            mp.inertia_kg_m2[(0, 0)],
+            mass * l * l / 12.0 + RHO * bm.iy_m4 * l
+        ) < 1e-9
+    );
     model.check_free().unwrap();
 }

@@ -135,21 +135,27 @@ impl Builder<'_> {
             reference_m: self.model.nodes[i].position,
             nodes: vec![i],
             weights: vec![1.0],
-            w: (0..6).map(|k| (k, d[k].expect("a 6-DOF node"), 1.0)).collect(),
+            w: (0..6)
+                .map(|k| (k, d[k].expect("a 6-DOF node"), 1.0))
+                .collect(),
         }
     }
 
     fn patch(&self, p: &Vector3<f64>, what: &str) -> Result<Station, String> {
-        let radius = self
-            .radius
-            .ok_or_else(|| format!("{what}: the body has solid (3-DOF) nodes there: attach_radius_m is needed"))?;
+        let radius = self.radius.ok_or_else(|| {
+            format!("{what}: the body has solid (3-DOF) nodes there: attach_radius_m is needed")
+        })?;
         let m = self.model;
         let mut nodes: Vec<usize> = (0..m.nodes.len())
             .filter(|&i| m.node_dofs[i][0].is_some() && (m.nodes[i].position - p).norm() <= radius)
             .collect();
         nodes.sort_by_key(|&i| m.nodes[i].id);
         let n = nodes.len() as f64;
-        let centroid = nodes.iter().map(|&i| m.nodes[i].position).sum::<Vector3<f64>>() / n.max(1.0);
+        let centroid = nodes
+            .iter()
+            .map(|&i| m.nodes[i].position)
+            .sum::<Vector3<f64>>()
+            / n.max(1.0);
         let mut a = Matrix3::zeros();
         for &i in &nodes {
             let d = m.nodes[i].position - centroid;
@@ -168,7 +174,9 @@ impl Builder<'_> {
                 m.nodes.get(near).map(|p| p.id).unwrap_or(0)
             ));
         }
-        let a_inv = a.try_inverse().ok_or_else(|| format!("{what}: singular RBE3 patch"))?;
+        let a_inv = a
+            .try_inverse()
+            .ok_or_else(|| format!("{what}: singular RBE3 patch"))?;
         let mut w = Vec::with_capacity(nodes.len() * 12);
         for &i in &nodes {
             let d = m.nodes[i].position - centroid;
@@ -212,10 +220,17 @@ impl Builder<'_> {
         Ok(self.add(station))
     }
 
-    fn travel(&mut self, a: &Vector3<f64>, b: &Vector3<f64>, what: &str) -> Result<Resolved, String> {
+    fn travel(
+        &mut self,
+        a: &Vector3<f64>,
+        b: &Vector3<f64>,
+        what: &str,
+    ) -> Result<Resolved, String> {
         let length = (b - a).norm();
         if !(length > 0.0) {
-            return Err(format!("{what}: the travel's start and end are the same point"));
+            return Err(format!(
+                "{what}: the travel's start and end are the same point"
+            ));
         }
         let u = (b - a) / length;
         let m = self.model;
@@ -240,16 +255,23 @@ impl Builder<'_> {
         let band = if with_rotations {
             dmin + self.radius.unwrap_or(0.0).max(tol)
         } else {
-            self.radius.ok_or_else(|| format!("{what}: the body has solid (3-DOF) nodes there: attach_radius_m is needed"))?
+            self.radius.ok_or_else(|| {
+                format!("{what}: the body has solid (3-DOF) nodes there: attach_radius_m is needed")
+            })?
         };
-        let mut near: Vec<(f64, f64, usize)> = candidates.into_iter().filter(|c| c.1 <= band).collect();
+        let mut near: Vec<(f64, f64, usize)> =
+            candidates.into_iter().filter(|c| c.1 <= band).collect();
         if near.is_empty() {
             return Err(format!(
                 "{what}: no node within {band:.6} m of the travel line (nearest at {dmin:.6} m)"
             ));
         }
         // One station per coordinate along the travel (nodes in one layer share it).
-        near.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.total_cmp(&y.1)).then(m.nodes[x.2].id.cmp(&m.nodes[y.2].id)));
+        near.sort_by(|x, y| {
+            x.0.total_cmp(&y.0)
+                .then(x.1.total_cmp(&y.1))
+                .then(m.nodes[x.2].id.cmp(&m.nodes[y.2].id))
+        });
         let mut layers: Vec<(f64, usize)> = Vec::new();
         for &(s, _, i) in &near {
             if layers.last().is_none_or(|l| s - l.0 > tol) {
@@ -258,7 +280,10 @@ impl Builder<'_> {
         }
         // Keep the layers within the travel and the nearest one beyond each end.
         let first = layers.iter().rposition(|l| l.0 <= tol).unwrap_or(0);
-        let last = layers.iter().position(|l| l.0 >= length - tol).unwrap_or(layers.len() - 1);
+        let last = layers
+            .iter()
+            .position(|l| l.0 >= length - tol)
+            .unwrap_or(layers.len() - 1);
         let mut stations = Vec::new();
         for &(s, i) in &layers[first..=last] {
             let station = if with_rotations {
@@ -274,7 +299,11 @@ impl Builder<'_> {
 }
 
 /// Resolves every attachment to stations. `radius`: `attach_radius_m` (needed on solids).
-pub(crate) fn layout(model: &FeModel, attachments: &[Attachment], radius: Option<f64>) -> Result<Layout, FeError> {
+pub(crate) fn layout(
+    model: &FeModel,
+    attachments: &[Attachment],
+    radius: Option<f64>,
+) -> Result<Layout, FeError> {
     let mut b = Builder {
         model,
         radius,

@@ -114,10 +114,21 @@ impl Beam {
             }
         }
         if self.elements == 0 || self.elements > 100_000 {
-            return Err(err(format!("elements = {}: must be 1 … 100000", self.elements)));
+            return Err(err(format!(
+                "elements = {}: must be 1 … 100000",
+                self.elements
+            )));
         }
-        let (a, b, y) = (Vector3::from(self.from_m), Vector3::from(self.to_m), Vector3::from(self.y_axis));
-        if a.iter().chain(b.iter()).chain(y.iter()).any(|v| !v.is_finite()) {
+        let (a, b, y) = (
+            Vector3::from(self.from_m),
+            Vector3::from(self.to_m),
+            Vector3::from(self.y_axis),
+        );
+        if a.iter()
+            .chain(b.iter())
+            .chain(y.iter())
+            .any(|v| !v.is_finite())
+        {
             return Err(err("from_m, to_m and y_axis must be finite".into()));
         }
         let axis = b - a;
@@ -133,12 +144,19 @@ impl Beam {
         let ey = ey.normalize();
         let ez = ex.cross(&ey);
         // Rows: the local axes in machine coordinates (local = Λ · machine).
-        Ok((axis, Matrix3::from_rows(&[ex.transpose(), ey.transpose(), ez.transpose()])))
+        Ok((
+            axis,
+            Matrix3::from_rows(&[ex.transpose(), ey.transpose(), ez.transpose()]),
+        ))
     }
 
     /// Element stiffness and mass in local coordinates, DOFs (u v w θx θy θz) per node.
     fn element(&self, l: f64) -> (M12, M12) {
-        let (e, g, rho) = (self.youngs_modulus_pa, self.shear_modulus_pa, self.density_kg_m3);
+        let (e, g, rho) = (
+            self.youngs_modulus_pa,
+            self.shear_modulus_pa,
+            self.density_kg_m3,
+        );
         let (a, kga) = (self.area_m2, self.shear_factor * self.area_m2 * g);
         let mut k = M12::zeros();
         let mut m = M12::zeros();
@@ -150,13 +168,21 @@ impl Beam {
                 }
             }
         };
-        let bar = |s: f64, mass: f64| ([[s, -s], [-s, s]], [[mass / 3.0, mass / 6.0], [mass / 6.0, mass / 3.0]]);
+        let bar = |s: f64, mass: f64| {
+            (
+                [[s, -s], [-s, s]],
+                [[mass / 3.0, mass / 6.0], [mass / 6.0, mass / 3.0]],
+            )
+        };
         let (ka, ma) = bar(e * a / l, rho * a * l);
         put([0, 6], ka, ma);
         let (kt, mt) = bar(g * self.torsion_m4 / l, rho * (self.iy_m4 + self.iz_m4) * l);
         put([3, 9], kt, mt);
         // x–y plane: v with θz = +dv/dx; x–z plane: w with θy = −dw/dx (sign s).
-        for (idx, i, s) in [([1, 5, 7, 11], self.iz_m4, 1.0), ([2, 4, 8, 10], self.iy_m4, -1.0)] {
+        for (idx, i, s) in [
+            ([1, 5, 7, 11], self.iz_m4, 1.0),
+            ([2, 4, 8, 10], self.iy_m4, -1.0),
+        ] {
             let (kb, mb) = bending(l, e * i, kga, rho * a, rho * i);
             let sign = [1.0, s, 1.0, s];
             for p in 0..4 {

@@ -12,7 +12,12 @@ impl FeModel {
     /// Reads an exported FE model and checks it: sizes, the DOF map against the nodes, mass
     /// properties (rigid-body mass > 0) and that the stiffness leaves the six rigid-body motions
     /// free. Every error names the file, the line where there is one, and what is wrong.
-    pub fn from_files(mass: &Path, stiffness: &Path, dofs: &Path, nodes: &Path) -> Result<FeModel, FeError> {
+    pub fn from_files(
+        mass: &Path,
+        stiffness: &Path,
+        dofs: &Path,
+        nodes: &Path,
+    ) -> Result<FeModel, FeError> {
         let name = |p: &Path| p.display().to_string();
         let (m_name, k_name) = (name(mass), name(stiffness));
         let m = mtx::read_symmetric(mass, &m_name)?;
@@ -20,7 +25,11 @@ impl FeModel {
         if m.nrows() != k.nrows() {
             return Err(FeError::file(
                 &m_name,
-                format!("the mass matrix is {0}×{0}, the stiffness matrix {k_name} {1}×{1}", m.nrows(), k.nrows()),
+                format!(
+                    "the mass matrix is {0}×{0}, the stiffness matrix {k_name} {1}×{1}",
+                    m.nrows(),
+                    k.nrows()
+                ),
             ));
         }
         for c in 0..m.ncols() {
@@ -49,9 +58,12 @@ fn rename(e: FeError, file: &str) -> FeError {
     }
 }
 
-fn reader(path: &Path, header: &[&str]) -> Result<(String, csv::Reader<std::io::Cursor<Vec<u8>>>), FeError> {
+type Table = csv::Reader<std::io::Cursor<Vec<u8>>>;
+
+fn reader(path: &Path, header: &[&str]) -> Result<(String, Table), FeError> {
     let file = path.display().to_string();
-    let bytes = read_input(path, MAX_TABLE_BYTES).map_err(|e| FeError::file(&file, e.to_string()))?;
+    let bytes =
+        read_input(path, MAX_TABLE_BYTES).map_err(|e| FeError::file(&file, e.to_string()))?;
     let mut rdr = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .comment(Some(b'#'))
@@ -66,7 +78,11 @@ fn reader(path: &Path, header: &[&str]) -> Result<(String, csv::Reader<std::io::
         return Err(FeError::line(
             &file,
             1,
-            format!("the header must be `{}`, found `{}`", header.join(","), got.join(",")),
+            format!(
+                "the header must be `{}`, found `{}`",
+                header.join(","),
+                got.join(",")
+            ),
         ));
     }
     Ok((file, rdr))
@@ -74,7 +90,7 @@ fn reader(path: &Path, header: &[&str]) -> Result<(String, csv::Reader<std::io::
 
 fn records(
     file: &str,
-    rdr: &mut csv::Reader<std::io::Cursor<Vec<u8>>>,
+    rdr: &mut Table,
     mut each: impl FnMut(usize, &csv::StringRecord) -> Result<(), String>,
 ) -> Result<(), FeError> {
     for rec in rdr.records() {
@@ -89,7 +105,8 @@ fn records(
 }
 
 fn node_id(s: &str) -> Result<u64, String> {
-    s.parse().map_err(|_| format!("node `{s}` is not a whole number ≥ 0"))
+    s.parse()
+        .map_err(|_| format!("node `{s}` is not a whole number ≥ 0"))
 }
 
 fn read_nodes(path: &Path) -> Result<Vec<Node>, FeError> {
@@ -134,7 +151,10 @@ fn read_dofs(path: &Path, nodes: &[Node], n: usize) -> Result<Vec<(u64, DofKind)
         let kind = DofKind::parse(&rec[1])
             .ok_or_else(|| format!("dof `{}` is none of ux uy uz rx ry rz", &rec[1]))?;
         if let Some(first) = seen.insert((id, kind), line) {
-            return Err(format!("node {id} {} given twice (first on line {first})", kind.name()));
+            return Err(format!(
+                "node {id} {} given twice (first on line {first})",
+                kind.name()
+            ));
         }
         map.push((id, kind));
         Ok(())
@@ -142,7 +162,10 @@ fn read_dofs(path: &Path, nodes: &[Node], n: usize) -> Result<Vec<(u64, DofKind)
     if map.len() != n {
         return Err(FeError::file(
             &file,
-            format!("{} DOF rows, but the matrices are {n}×{n} (one row per matrix row, in row order)", map.len()),
+            format!(
+                "{} DOF rows, but the matrices are {n}×{n} (one row per matrix row, in row order)",
+                map.len()
+            ),
         ));
     }
     Ok(map)

@@ -50,14 +50,14 @@ fn brick(h: [f64; 3], e: f64, nu: f64, rho: f64) -> (M24, M24) {
         ];
         let mut b = SMatrix::<f64, 6, 24>::zeros();
         let mut n = [0.0; 8];
-        for c in 0..8 {
+        for (c, nc) in n.iter_mut().enumerate() {
             let s = [
                 if c & 1 == 0 { -1.0 } else { 1.0 },
                 if c & 2 == 0 { -1.0 } else { 1.0 },
                 if c & 4 == 0 { -1.0 } else { 1.0 },
             ];
             let f = |a: usize| 1.0 + s[a] * xi[a];
-            n[c] = f(0) * f(1) * f(2) / 8.0;
+            *nc = f(0) * f(1) * f(2) / 8.0;
             // dN/dx_a = (2/h_a) dN/dξ_a.
             let dn = [
                 s[0] * f(1) * f(2) / 8.0 * 2.0 / h[0],
@@ -106,9 +106,11 @@ impl FeModel {
         if block.divisions.contains(&0) || block.size_m.iter().any(|s| !(*s > 0.0)) {
             return bad("divisions and sizes must be positive".into());
         }
-        if !(block.youngs_modulus_pa > 0.0 && block.density_kg_m3 > 0.0)
-            || !(block.poisson_ratio > -1.0 && block.poisson_ratio < 0.5)
-        {
+        let material = block.youngs_modulus_pa > 0.0
+            && block.density_kg_m3 > 0.0
+            && block.poisson_ratio > -1.0
+            && block.poisson_ratio < 0.5;
+        if !material {
             return bad("E, density > 0 and −1 < ν < 0.5 needed".into());
         }
         let [nx, ny, nz] = block.node_counts();
@@ -116,7 +118,12 @@ impl FeModel {
             return bad("too many nodes".into());
         }
         let h: [f64; 3] = std::array::from_fn(|a| block.size_m[a] / block.divisions[a] as f64);
-        let (ke, me) = brick(h, block.youngs_modulus_pa, block.poisson_ratio, block.density_kg_m3);
+        let (ke, me) = brick(
+            h,
+            block.youngs_modulus_pa,
+            block.poisson_ratio,
+            block.density_kg_m3,
+        );
         let node = |i: usize, j: usize, k: usize| i + nx * (j + ny * k);
         let [ex, ey, ez] = block.divisions;
         let per = ex * ey * ez * 300;
@@ -124,8 +131,9 @@ impl FeModel {
         for k in 0..ez {
             for j in 0..ey {
                 for i in 0..ex {
-                    let corners: [usize; 8] =
-                        std::array::from_fn(|c| node(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1)));
+                    let corners: [usize; 8] = std::array::from_fn(|c| {
+                        node(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1))
+                    });
                     for p in 0..24 {
                         for q in 0..24 {
                             let (r, c) = (3 * corners[p / 3] + p % 3, 3 * corners[q / 3] + q % 3);
@@ -145,7 +153,11 @@ impl FeModel {
                 for i in 0..nx {
                     nodes.push(Node {
                         id: node(i, j, k) as u64 + 1,
-                        position: o + Vector3::new(i as f64 * h[0], j as f64 * h[1], k as f64 * h[2]),
+                        position: o + Vector3::new(
+                            i as f64 * h[0],
+                            j as f64 * h[1],
+                            k as f64 * h[2],
+                        ),
                     });
                 }
             }

@@ -18,6 +18,9 @@
 //! Everything on the FE side is sparse (faer's supernodal Cholesky, shift-invert restarted
 //! Lanczos from faer's matrix-free eigensolver); only the reduced matrices are dense.
 
+// `!(x > limit)` is meant: a NaN must fail every check, which `x <= limit` would let through.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 mod attach;
 mod beam;
 mod files;
@@ -29,7 +32,9 @@ mod sparse;
 pub use attach::{Attachment, AttachmentKind, Station};
 pub use beam::Beam;
 pub use hex8::Hex8Block;
-pub use reduce::{reduce, FeSummary, ReducedBody, ReductionSettings, StationSummary};
+pub use reduce::{
+    reduce, FeSummary, ReducedBody, ReductionSettings, StationSummary, CUTOFF_MARGIN,
+};
 pub use sparse::{free_free_frequencies_hz, lowest_modes, Modes};
 
 use faer::sparse::SparseColMat;
@@ -185,10 +190,7 @@ impl FeModel {
         if dofs.len() != n {
             return Err(FeError::file(
                 source,
-                format!(
-                    "the DOF map has {} rows, the matrices {n}",
-                    dofs.len()
-                ),
+                format!("the DOF map has {} rows, the matrices {n}", dofs.len()),
             ));
         }
         let index: std::collections::HashMap<u64, usize> =
@@ -205,7 +207,11 @@ impl FeModel {
             if node_dofs[i][kind.index()].replace(row).is_some() {
                 return Err(FeError::file(
                     source,
-                    format!("DOF map row {}: node {id} {} given twice", row + 1, kind.name()),
+                    format!(
+                        "DOF map row {}: node {id} {} given twice",
+                        row + 1,
+                        kind.name()
+                    ),
                 ));
             }
             map.push((i, kind));
@@ -213,7 +219,9 @@ impl FeModel {
         for (node, d) in nodes.iter().zip(&node_dofs) {
             let translations = d[..3].iter().filter(|r| r.is_some()).count();
             let rotations = d[3..].iter().filter(|r| r.is_some()).count();
-            if (translations + rotations > 0 && translations < 3) || (rotations > 0 && rotations < 3) {
+            if (translations + rotations > 0 && translations < 3)
+                || (rotations > 0 && rotations < 3)
+            {
                 return Err(FeError::file(
                     source,
                     format!(
@@ -298,7 +306,9 @@ impl FeModel {
         let r = self.rigid_modes(&origin);
         let m6 = to_matrix6(&sandwich(&self.mass, r.as_ref()));
         let mass = (m6[(0, 0)] + m6[(1, 1)] + m6[(2, 2)]) / 3.0;
-        let spread = (0..3).map(|k| (m6[(k, k)] - mass).abs()).fold(0.0, f64::max);
+        let spread = (0..3)
+            .map(|k| (m6[(k, k)] - mass).abs())
+            .fold(0.0, f64::max);
         if !(mass > 0.0) || !mass.is_finite() {
             return Err(FeError::file(
                 &self.source,
@@ -320,8 +330,11 @@ impl FeModel {
         }
         // Static moments: the block M_tθ = −m skew(c) about the origin.
         let s = m6.fixed_view::<3, 3>(0, 3).into_owned();
-        let cog = Vector3::new(s[(1, 2)] - s[(2, 1)], s[(2, 0)] - s[(0, 2)], s[(0, 1)] - s[(1, 0)])
-            / (2.0 * mass);
+        let cog = Vector3::new(
+            s[(1, 2)] - s[(2, 1)],
+            s[(2, 0)] - s[(0, 2)],
+            s[(0, 1)] - s[(1, 0)],
+        ) / (2.0 * mass);
         let skew = cog.cross_matrix();
         // Parallel-axis theorem: J_origin = J_cog + m (|c|² I − c cᵀ) = J_cog − m skew(c)².
         let inertia = m6.fixed_view::<3, 3>(3, 3).into_owned() + mass * skew * skew;

@@ -31,7 +31,8 @@ struct Entry {
 
 /// Reads a square symmetric matrix. `file` is the name errors carry.
 pub fn read_symmetric(path: &Path, file: &str) -> Result<SparseMatrix, FeError> {
-    let reader = open_input(path, MAX_MATRIX_BYTES).map_err(|e| FeError::file(file, e.to_string()))?;
+    let reader =
+        open_input(path, MAX_MATRIX_BYTES).map_err(|e| FeError::file(file, e.to_string()))?;
     parse(BufReader::with_capacity(1 << 20, reader), file)
 }
 
@@ -49,7 +50,10 @@ pub fn parse(mut reader: impl BufRead, file: &str) -> Result<SparseMatrix, FeErr
         if bytes > MAX_MATRIX_BYTES {
             return Err(FeError::file(
                 file,
-                format!("holds more than {} MiB (the most eij reads from one matrix file)", MAX_MATRIX_BYTES >> 20),
+                format!(
+                    "holds more than {} MiB (the most eij reads from one matrix file)",
+                    MAX_MATRIX_BYTES >> 20
+                ),
             ));
         }
         *line_no += 1;
@@ -69,7 +73,11 @@ pub fn parse(mut reader: impl BufRead, file: &str) -> Result<SparseMatrix, FeErr
 
     let (n, nnz) = loop {
         if !next_line(&mut buf, &mut line_no)? {
-            return Err(FeError::line(file, line_no, "the size line `rows columns entries` is missing"));
+            return Err(FeError::line(
+                file,
+                line_no,
+                "the size line `rows columns entries` is missing",
+            ));
         }
         let line = text(&buf, line_no)?;
         if line.is_empty() || line.starts_with('%') {
@@ -80,10 +88,18 @@ pub fn parse(mut reader: impl BufRead, file: &str) -> Result<SparseMatrix, FeErr
         match parsed.as_slice() {
             [Some(r), Some(c), Some(e)] => {
                 if r != c {
-                    return Err(FeError::line(file, line_no, format!("the matrix is {r}×{c}, not square")));
+                    return Err(FeError::line(
+                        file,
+                        line_no,
+                        format!("the matrix is {r}×{c}, not square"),
+                    ));
                 }
                 if *r == 0 || *r > u32::MAX as usize {
-                    return Err(FeError::line(file, line_no, format!("matrix size {r} out of range")));
+                    return Err(FeError::line(
+                        file,
+                        line_no,
+                        format!("matrix size {r} out of range"),
+                    ));
                 }
                 break (*r, *e);
             }
@@ -91,7 +107,10 @@ pub fn parse(mut reader: impl BufRead, file: &str) -> Result<SparseMatrix, FeErr
                 return Err(FeError::line(
                     file,
                     line_no,
-                    format!("expected the size line `rows columns entries`, found `{}`", clip(&line)),
+                    format!(
+                        "expected the size line `rows columns entries`, found `{}`",
+                        clip(&line)
+                    ),
                 ))
             }
         }
@@ -99,32 +118,61 @@ pub fn parse(mut reader: impl BufRead, file: &str) -> Result<SparseMatrix, FeErr
 
     let mut entries: Vec<Entry> = Vec::with_capacity(nnz.min(1 << 26));
     while next_line(&mut buf, &mut line_no)? {
-        let line = std::str::from_utf8(&buf).map_err(|_| FeError::line(file, line_no, "not text (invalid UTF-8)"))?;
+        let line = std::str::from_utf8(&buf)
+            .map_err(|_| FeError::line(file, line_no, "not text (invalid UTF-8)"))?;
         let line = line.trim();
         if line.is_empty() || line.starts_with('%') {
             continue;
         }
         if entries.len() == nnz {
-            return Err(FeError::line(file, line_no, format!("more entries than the {nnz} the size line declares")));
+            return Err(FeError::line(
+                file,
+                line_no,
+                format!("more entries than the {nnz} the size line declares"),
+            ));
         }
         let mut f = line.split_ascii_whitespace();
         let (Some(a), Some(b), Some(v), None) = (f.next(), f.next(), f.next(), f.next()) else {
-            return Err(FeError::line(file, line_no, format!("expected `row column value`, found `{}`", clip(line))));
+            return Err(FeError::line(
+                file,
+                line_no,
+                format!("expected `row column value`, found `{}`", clip(line)),
+            ));
         };
         let index = |s: &str, what: &str| -> Result<u32, FeError> {
             match s.parse::<usize>() {
-                Ok(0) => Err(FeError::line(file, line_no, format!("{what} index 0: Matrix Market indices start at 1"))),
-                Ok(i) if i > n => Err(FeError::line(file, line_no, format!("{what} index {i} beyond the matrix size {n}"))),
+                Ok(0) => Err(FeError::line(
+                    file,
+                    line_no,
+                    format!("{what} index 0: Matrix Market indices start at 1"),
+                )),
+                Ok(i) if i > n => Err(FeError::line(
+                    file,
+                    line_no,
+                    format!("{what} index {i} beyond the matrix size {n}"),
+                )),
                 Ok(i) => Ok((i - 1) as u32),
-                Err(_) => Err(FeError::line(file, line_no, format!("{what} index `{}` is not a positive whole number", clip(s)))),
+                Err(_) => Err(FeError::line(
+                    file,
+                    line_no,
+                    format!("{what} index `{}` is not a positive whole number", clip(s)),
+                )),
             }
         };
         let (r, c) = (index(a, "row")?, index(b, "column")?);
-        let value: f64 = v
-            .parse()
-            .map_err(|_| FeError::line(file, line_no, format!("value `{}` is not a number", clip(v))))?;
+        let value: f64 = v.parse().map_err(|_| {
+            FeError::line(
+                file,
+                line_no,
+                format!("value `{}` is not a number", clip(v)),
+            )
+        })?;
         if !value.is_finite() {
-            return Err(FeError::line(file, line_no, format!("value {value} is not finite")));
+            return Err(FeError::line(
+                file,
+                line_no,
+                format!("value {value} is not finite"),
+            ));
         }
         entries.push(Entry {
             row: r.max(c),
@@ -138,7 +186,10 @@ pub fn parse(mut reader: impl BufRead, file: &str) -> Result<SparseMatrix, FeErr
         return Err(FeError::line(
             file,
             line_no,
-            format!("the file ends after {} entries, the size line declares {nnz}", entries.len()),
+            format!(
+                "the file ends after {} entries, the size line declares {nnz}",
+                entries.len()
+            ),
         ));
     }
     assemble(entries, n, symmetric, file)
@@ -146,7 +197,10 @@ pub fn parse(mut reader: impl BufRead, file: &str) -> Result<SparseMatrix, FeErr
 
 /// `Ok(true)` for symmetric storage, `Ok(false)` for general.
 fn parse_header(header: &str) -> Result<bool, String> {
-    let f: Vec<String> = header.split_ascii_whitespace().map(|s| s.to_ascii_lowercase()).collect();
+    let f: Vec<String> = header
+        .split_ascii_whitespace()
+        .map(|s| s.to_ascii_lowercase())
+        .collect();
     if f.first().map(String::as_str) != Some("%%matrixmarket") {
         return Err(format!(
             "not a Matrix Market file: the first line must be `%%MatrixMarket matrix coordinate real symmetric` (or `general`), found `{}`",
@@ -154,10 +208,15 @@ fn parse_header(header: &str) -> Result<bool, String> {
         ));
     }
     let [_, object, format, field, symmetry] = f.as_slice() else {
-        return Err(format!("Matrix Market header needs 5 words, found `{}`", clip(header)));
+        return Err(format!(
+            "Matrix Market header needs 5 words, found `{}`",
+            clip(header)
+        ));
     };
     if object != "matrix" || format != "coordinate" {
-        return Err(format!("only `matrix coordinate` files are read, found `{object} {format}`"));
+        return Err(format!(
+            "only `matrix coordinate` files are read, found `{object} {format}`"
+        ));
     }
     if field != "real" && field != "integer" && field != "double" {
         return Err(format!("only real matrices are read, found `{field}`"));
@@ -165,7 +224,9 @@ fn parse_header(header: &str) -> Result<bool, String> {
     match symmetry.as_str() {
         "symmetric" => Ok(true),
         "general" => Ok(false),
-        s => Err(format!("storage `{s}`: FE matrices are read as `symmetric` or `general`")),
+        s => Err(format!(
+            "storage `{s}`: FE matrices are read as `symmetric` or `general`"
+        )),
     }
 }
 
@@ -178,7 +239,12 @@ fn clip(s: &str) -> String {
 }
 
 /// Pairs the entries of each position, checks symmetry and builds both triangles.
-fn assemble(mut entries: Vec<Entry>, n: usize, symmetric: bool, file: &str) -> Result<SparseMatrix, FeError> {
+fn assemble(
+    mut entries: Vec<Entry>,
+    n: usize,
+    symmetric: bool,
+    file: &str,
+) -> Result<SparseMatrix, FeError> {
     entries.sort_unstable_by_key(|e| (e.col, e.row, e.upper));
     let scale = entries.iter().fold(0.0f64, |a, e| a.max(e.value.abs()));
     let mut lower: Vec<(u32, u32, f64)> = Vec::with_capacity(entries.len());
@@ -292,7 +358,11 @@ pub(crate) fn full_from_lower(n: usize, lower: &[(u32, u32, f64)]) -> SparseMatr
 
 /// Writes a symmetric matrix as `coordinate real symmetric` (lower triangle, 17 digits), the
 /// form FE programs export and scipy's `mmread` reads.
-pub fn write_symmetric(out: &mut impl Write, a: &SparseMatrix, comment: &str) -> std::io::Result<()> {
+pub fn write_symmetric(
+    out: &mut impl Write,
+    a: &SparseMatrix,
+    comment: &str,
+) -> std::io::Result<()> {
     let nnz = (0..a.ncols())
         .map(|c| a.row_idx_of_col_raw(c).iter().filter(|&&r| r >= c).count())
         .sum::<usize>();

@@ -10,14 +10,16 @@
 use super::{FeError, FeModel, SparseMatrix};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
-use faer::matrix_free::eigen::{partial_self_adjoint_eigen, partial_self_adjoint_eigen_scratch, PartialEigenParams};
+use faer::matrix_free::eigen::{
+    partial_self_adjoint_eigen, partial_self_adjoint_eigen_scratch, PartialEigenParams,
+};
 use faer::matrix_free::LinOp;
+use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, supernodal::SupernodalLltRef, CholeskySymbolicParams, SymbolicCholesky,
-    SymbolicCholeskyRaw, SymmetricOrdering,
+    factorize_symbolic_cholesky, supernodal::SupernodalLltRef, CholeskySymbolicParams,
+    SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
 };
 use faer::sparse::linalg::SupernodalThreshold;
-use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::{Accum, Conj, Mat, MatMut, MatRef, Par, Side};
 
 /// Pᵀ L Lᵀ P of a sparse symmetric positive definite matrix (supernodal, AMD ordering).
@@ -28,7 +30,12 @@ pub(crate) struct Factor {
 
 impl std::fmt::Debug for Factor {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "Factor(n = {}, nnz(L) = {})", self.symbolic.nrows(), self.values.len())
+        write!(
+            f,
+            "Factor(n = {}, nnz(L) = {})",
+            self.symbolic.nrows(),
+            self.values.len()
+        )
     }
 }
 
@@ -40,11 +47,13 @@ impl Factor {
             supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
             ..Default::default()
         };
-        let symbolic = factorize_symbolic_cholesky(a.symbolic(), Side::Lower, SymmetricOrdering::Amd, params)
-            .map_err(|e| format!("symbolic Cholesky failed: {e:?}"))?;
+        let symbolic =
+            factorize_symbolic_cholesky(a.symbolic(), Side::Lower, SymmetricOrdering::Amd, params)
+                .map_err(|e| format!("symbolic Cholesky failed: {e:?}"))?;
         let mut values = vec![0.0; symbolic.len_val()];
         let par = Par::Seq;
-        let mut mem = MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()));
+        let mut mem =
+            MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()));
         symbolic
             .factorize_numeric_llt(
                 &mut values,
@@ -62,12 +71,16 @@ impl Factor {
     fn supernodal(&self) -> SupernodalLltRef<'_, usize, f64> {
         match self.symbolic.raw() {
             SymbolicCholeskyRaw::Supernodal(s) => SupernodalLltRef::new(s, &self.values),
-            SymbolicCholeskyRaw::Simplicial(_) => unreachable!("the factorisation is forced supernodal"),
+            SymbolicCholeskyRaw::Simplicial(_) => {
+                unreachable!("the factorisation is forced supernodal")
+            }
         }
     }
 
     fn scratch(&self, k: usize) -> MemBuffer {
-        MemBuffer::new(StackReq::any_of(&[self.symbolic.solve_in_place_scratch::<f64>(k, Par::Seq)]))
+        MemBuffer::new(StackReq::any_of(&[self
+            .symbolic
+            .solve_in_place_scratch::<f64>(k, Par::Seq)]))
     }
 
     /// x ← L⁻¹ P x.
@@ -86,8 +99,12 @@ impl Factor {
     pub(crate) fn lt_solve(&self, x: MatMut<'_, f64>) {
         let mut x = x;
         let mut mem = self.scratch(x.ncols());
-        self.supernodal()
-            .l_transpose_solve_with_conj(Conj::No, x.rb_mut(), Par::Seq, MemStack::new(&mut mem));
+        self.supernodal().l_transpose_solve_with_conj(
+            Conj::No,
+            x.rb_mut(),
+            Par::Seq,
+            MemStack::new(&mut mem),
+        );
         if let Some(perm) = self.symbolic.perm() {
             let tmp = x.to_owned();
             faer::perm::permute_rows(x, tmp.as_ref(), perm.inverse());
@@ -103,7 +120,14 @@ impl Factor {
 /// y = S x for a sparse S.
 pub(crate) fn spmm(s: &SparseMatrix, x: MatRef<'_, f64>) -> Mat<f64> {
     let mut y = Mat::zeros(s.nrows(), x.ncols());
-    faer::sparse::linalg::matmul::sparse_dense_matmul(y.as_mut(), Accum::Replace, s.as_ref(), x, 1.0, Par::Seq);
+    faer::sparse::linalg::matmul::sparse_dense_matmul(
+        y.as_mut(),
+        Accum::Replace,
+        s.as_ref(),
+        x,
+        1.0,
+        Par::Seq,
+    );
     y
 }
 
@@ -159,7 +183,13 @@ impl LinOp<f64> for Operator<'_> {
         self.factor.l_solve(out.rb_mut());
         self.project(out);
     }
-    fn conj_apply(&self, out: MatMut<'_, f64>, rhs: MatRef<'_, f64>, par: Par, stack: &mut MemStack) {
+    fn conj_apply(
+        &self,
+        out: MatMut<'_, f64>,
+        rhs: MatRef<'_, f64>,
+        par: Par,
+        stack: &mut MemStack,
+    ) {
         self.apply(out, rhs, par, stack);
     }
 }
@@ -176,7 +206,10 @@ pub struct Modes {
 impl Modes {
     /// Frequencies f = √λ / 2π, Hz (negative round-off taken as 0).
     pub fn frequencies_hz(&self) -> Vec<f64> {
-        self.eigenvalues.iter().map(|l| l.max(0.0).sqrt() / std::f64::consts::TAU).collect()
+        self.eigenvalues
+            .iter()
+            .map(|l| l.max(0.0).sqrt() / std::f64::consts::TAU)
+            .collect()
     }
 }
 
@@ -217,7 +250,9 @@ pub(crate) fn shift_invert(
         scale: 1.0,
     };
     // Start vector: smooth and deterministic, inside the constrained space.
-    let mut v0 = Mat::from_fn(n, 1, |i, _| 1.0 + 0.5 * ((i as f64) * 0.618_033_988_7).sin());
+    let mut v0 = Mat::from_fn(n, 1, |i, _| {
+        1.0 + 0.5 * ((i as f64) * 0.618_033_988_7).sin()
+    });
     op.project(v0.as_mut());
     // Scale C so its largest eigenvalue is about 1: the Lanczos tolerance is absolute.
     let mut w = v0.clone();
@@ -229,7 +264,12 @@ pub(crate) fn shift_invert(
         }
         w *= faer::Scale(1.0 / norm);
         let mut out = Mat::zeros(n, 1);
-        op.apply(out.as_mut(), w.as_ref(), Par::Seq, MemStack::new(&mut stack_dummy));
+        op.apply(
+            out.as_mut(),
+            w.as_ref(),
+            Par::Seq,
+            MemStack::new(&mut stack_dummy),
+        );
         w = out;
     }
     let top = w.norm_l2();
@@ -246,7 +286,12 @@ pub(crate) fn shift_invert(
         max_restarts: 2000,
         ..Default::default()
     };
-    let mut mem = MemBuffer::new(partial_self_adjoint_eigen_scratch::<f64>(&op, count, Par::Seq, params));
+    let mut mem = MemBuffer::new(partial_self_adjoint_eigen_scratch::<f64>(
+        &op,
+        count,
+        Par::Seq,
+        params,
+    ));
     let mut z = Mat::zeros(n, count);
     let mut mu = vec![0.0; count];
     let info = partial_self_adjoint_eigen(
@@ -289,7 +334,12 @@ pub(crate) fn shift_invert(
 
 /// The `count` lowest modes of K φ = λ M φ of a model held at the DOFs `fixed` (matrix rows;
 /// none for a free body, then σ < 0 is needed).
-pub fn lowest_modes(model: &FeModel, fixed: &[usize], sigma: f64, count: usize) -> Result<Modes, FeError> {
+pub fn lowest_modes(
+    model: &FeModel,
+    fixed: &[usize],
+    sigma: f64,
+    count: usize,
+) -> Result<Modes, FeError> {
     let n = model.n_dofs();
     let mut d = Mat::zeros(n, fixed.len());
     for (c, &row) in fixed.iter().enumerate() {
@@ -299,23 +349,31 @@ pub fn lowest_modes(model: &FeModel, fixed: &[usize], sigma: f64, count: usize) 
     for &row in fixed {
         add_diagonal(&mut a, row);
     }
-    let factor = Factor::new(&a).map_err(|e| FeError::file(&model.source, format!("K − σM: {e}")))?;
+    let factor =
+        Factor::new(&a).map_err(|e| FeError::file(&model.source, format!("K − σM: {e}")))?;
     drop(a);
-    shift_invert(&factor, &model.mass, d.as_ref(), sigma, count).map_err(|e| FeError::file(&model.source, e))
+    shift_invert(&factor, &model.mass, d.as_ref(), sigma, count)
+        .map_err(|e| FeError::file(&model.source, e))
 }
 
 /// The `count` lowest elastic free-free frequencies of the full model, Hz: the rigid-body modes
 /// deflated (Rᵀ M φ = 0), shift σ = −(2π·`shift_hz`)², which should lie below the first elastic
 /// frequency (a tenth of it is a good choice).
-pub fn free_free_frequencies_hz(model: &FeModel, count: usize, shift_hz: f64) -> Result<Vec<f64>, FeError> {
+pub fn free_free_frequencies_hz(
+    model: &FeModel,
+    count: usize,
+    shift_hz: f64,
+) -> Result<Vec<f64>, FeError> {
     let sigma = -(std::f64::consts::TAU * shift_hz).powi(2);
     let a = shifted(&model.stiffness, &model.mass, -sigma);
-    let factor = Factor::new(&a).map_err(|e| FeError::file(&model.source, format!("K − σM: {e}")))?;
+    let factor =
+        Factor::new(&a).map_err(|e| FeError::file(&model.source, format!("K − σM: {e}")))?;
     drop(a);
     let (lo, hi) = model.bounds();
     let r = model.rigid_modes(&(0.5 * (lo + hi)));
     let mr = spmm(&model.mass, r.as_ref());
-    let modes = shift_invert(&factor, &model.mass, mr.as_ref(), sigma, count).map_err(|e| FeError::file(&model.source, e))?;
+    let modes = shift_invert(&factor, &model.mass, mr.as_ref(), sigma, count)
+        .map_err(|e| FeError::file(&model.source, e))?;
     Ok(modes.frequencies_hz())
 }
 
