@@ -8,12 +8,14 @@
 //! stages before it (`tests/architecture.rs` checks this, and that no import circle exists):
 //!
 //! ```text
-//! text, axes, io ─► machine ─► mbs ─► control ─► rtest ─► sim ─► measured
+//! text, axes, io ─► fe ─► machine ─► mbs ─► control ─► rtest ─► sim ─► measured
 //!                ─► predict ─► ident ─► map ─► compensation ─► report ─► cli
 //! ```
 //!
 //! * [`text`], [`axes`], [`io`]: numbers in messages, the names shared along the data path
 //!   (axes, planes, EIJ), files in and out (size limits, atomic outputs, delimited text).
+//! * [`fe`]: elastic bodies from finite-element models, reduced (Craig–Bampton) to the
+//!   coordinates of the multi-body model.
 //! * [`machine`]: the validated machine description (bodies, axes, guideways, drives, control),
 //!   read from TOML with catalogue look-up of carriage stiffness.
 //! * [`mbs`]: assembly of the mass, damping and stiffness matrices at an axis position; modal

@@ -17,6 +17,7 @@ use syn::visit::Visit;
 
 /// The stages in data-path order: a module may import from its own stage and the stages before
 /// it, never from a later one. The first three are the shared vocabulary and file handling;
+/// `fe` (elastic bodies from finite-element models) comes before the machine that uses them;
 /// `rtest` (the evaluation math) comes before `sim`, which writes its circle tests as the
 /// evaluation's `CircleSeries`; `measured` reads files into what `rtest` evaluates; `cli` is the
 /// binary (`src/main.rs`). A new top-level module has to be placed here.
@@ -24,6 +25,7 @@ const STAGES: &[&str] = &[
     "text",
     "axes",
     "io",
+    "fe",
     "machine",
     "mbs",
     "control",
