@@ -1,5 +1,6 @@
 //! The `eij` command line: a thin shell over the library; see `eij --help`.
 
+#[macro_use]
 mod cli;
 
 use clap::Parser;
@@ -17,14 +18,31 @@ fn first_paragraph(text: &str) -> String {
         .to_string()
 }
 
-fn main() -> std::process::ExitCode {
-    // Like other Unix tools, end quietly when the reader of our output goes away
-    // (`eij identify | head`) instead of panicking on a broken pipe.
-    #[cfg(unix)]
-    // SAFETY: restoring the default disposition of SIGPIPE before any thread is started.
-    unsafe {
-        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+/// Caps the worker threads at what the machine has: `RAYON_NUM_THREADS=100000` would start
+/// that many threads and stall the machine for minutes; more threads than cores never run a
+/// job faster.
+fn cap_threads() {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let Some(asked) = std::env::var_os("RAYON_NUM_THREADS") else {
+        return;
+    };
+    let Ok(n) = asked.to_string_lossy().trim().parse::<usize>() else {
+        return;
+    };
+    if n > cores {
+        errln!(
+            "eij: warning: RAYON_NUM_THREADS={n} is more than the {cores} core(s) this process may use: {cores} worker threads"
+        );
+        let _ = rayon::ThreadPoolBuilder::new()
+            .num_threads(cores)
+            .build_global();
     }
+}
+
+fn main() -> std::process::ExitCode {
+    // SIGPIPE stays ignored (Rust's default): a reader that goes away (`eij identify | head`)
+    // is a failed write to standard output, which `console` turns into a quiet end, after
+    // the run's files are written.
     let cli = match cli::Cli::try_parse() {
         Ok(cli) => cli,
         Err(e)
@@ -35,16 +53,27 @@ fn main() -> std::process::ExitCode {
         }
         Err(e) => {
             // clap's message spans several lines (usage, tips); the contract is one line.
-            eprintln!("eij: error: {}", first_paragraph(&e.render().to_string()));
+            errln!("eij: error: {}", first_paragraph(&e.render().to_string()));
             return std::process::ExitCode::from(e.exit_code().clamp(1, 255) as u8);
         }
     };
-    match cli.run() {
-        Ok(()) => std::process::ExitCode::SUCCESS,
-        Err(e) => {
+    cap_threads();
+    let result = cli.run();
+    let printed = cli::console::finish();
+    match (result, printed) {
+        (Err(e), _) => {
             let line = eij::text::compact_numbers(&format!("{e:#}").replace('\n', " "));
-            eprintln!("eij: error: {line}");
+            errln!("eij: error: {line}");
             std::process::ExitCode::FAILURE
         }
+        // The reader stopped reading: what it wanted it has, the files are written.
+        (Ok(()), Some(e)) if e.kind() == std::io::ErrorKind::BrokenPipe => {
+            std::process::ExitCode::SUCCESS
+        }
+        (Ok(()), Some(e)) => {
+            errln!("eij: error: standard output: cannot write: {e} (the output files, if any, are written)");
+            std::process::ExitCode::FAILURE
+        }
+        (Ok(()), None) => std::process::ExitCode::SUCCESS,
     }
 }

@@ -743,24 +743,10 @@ fn existing_outputs_are_replaced_atomically() {
     );
     let (id_toml, id_json) = (s.s("id.toml"), s.s("id.json"));
     std::fs::write(&id_json, old).unwrap();
-    check(
-        "id.toml",
-        &[
-            "identify",
-            "--machine",
-            DEMO,
-            "--measured",
-            ZX_CSV,
-            "--param",
-            "z.guideway_normal",
-            "--quiet",
-            "--out",
-            &id_toml,
-            "--report",
-            &id_json,
-        ],
-        "",
-    );
+    let mut identify = common::identify_args(&id_toml, &id_json);
+    identify.push("--quiet".into());
+    let identify: Vec<&str> = identify.iter().map(String::as_str).collect();
+    check("id.toml", &identify, "");
     assert!(std::fs::read_to_string(&id_json).unwrap().starts_with('{'));
 }
 

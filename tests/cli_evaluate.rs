@@ -221,8 +221,14 @@ fn json_output_follows_the_contract() {
         out.to_str().unwrap(),
     ]);
     assert!(r.ok, "{}", r.stderr);
-    // No set radius anywhere: said on standard error and in the JSON.
-    assert_eq!(r.stderr.lines().count(), 1, "{}", r.stderr);
+    // No set radius anywhere: said on standard error and in the JSON; then what was written.
+    assert_eq!(r.stderr.lines().count(), 2, "{}", r.stderr);
+    assert!(
+        r.stderr
+            .ends_with(&format!("eij: wrote {}\n", out.display())),
+        "{}",
+        r.stderr
+    );
     assert!(r.stderr.contains("no set radius given"), "{}", r.stderr);
     let v: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
     let top: Vec<&String> = v.as_object().unwrap().keys().collect();

@@ -2,35 +2,21 @@
 //! figure) over an old set, killed at random moments by SIGTERM or SIGKILL. Afterwards the
 //! outputs are all old or all new, never mixed, and no temporary file is left: SIGTERM during
 //! the commit is held until it ends; a SIGKILL inside the commit's renames leaves a journal that
-//! the next commit into the folder completes (`eij::io` module docs).
+//! the next commit of those outputs completes (`eij::io` module docs).
 
 mod common;
 
 use common::mutation::Rng;
-use common::{eij, Scratch, DEMO, ZX_CSV};
+use common::Scratch;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 const OUTPUTS: [&str; 4] = ["id.toml", "id.json", "id.csv", "id.svg"];
 
 fn args(s: &Scratch) -> Vec<String> {
-    let mut v: Vec<String> = [
-        "identify",
-        "--machine",
-        DEMO,
-        "--measured",
-        ZX_CSV,
-        "--param",
-        "z.guideway_normal",
-        "--quiet",
-        "--no-design",
-    ]
-    .map(String::from)
-    .to_vec();
-    for (flag, name) in ["--out", "--report", "--stiffness-out", "--plot"]
-        .into_iter()
-        .zip(OUTPUTS)
-    {
+    let mut v = common::identify_args(&s.s(OUTPUTS[0]), &s.s(OUTPUTS[1]));
+    v.push("--quiet".into());
+    for (flag, name) in ["--stiffness-out", "--plot"].into_iter().zip(&OUTPUTS[2..]) {
         v.push(flag.into());
         v.push(s.s(name));
     }
@@ -91,11 +77,11 @@ fn a_killed_identify_leaves_the_old_or_the_new_set() {
         let left = leftovers(&s);
         if !left.is_empty() {
             assert_eq!(signal, libc::SIGKILL, "SIGTERM left {left:?}");
-            // The next commit into the folder completes or drops the killed one's.
-            let recover = s.s("recover.csv");
-            let out = eij(&["stiffness", "--machine", DEMO, "--out", &recover]);
-            assert!(out.status.success());
-            std::fs::remove_file(&recover).unwrap();
+            // The next commit of these outputs completes or drops the killed one's, in its
+            // first step (recovery), whichever folder it starts from.
+            let dir = s.0.canonicalize().unwrap();
+            let outputs: Vec<std::path::PathBuf> = OUTPUTS.iter().map(|n| dir.join(n)).collect();
+            eij::io::recover(&dir, &outputs);
             assert!(leftovers(&s).is_empty(), "{:?}", leftovers(&s));
         }
         let contents: Vec<String> = OUTPUTS

@@ -42,11 +42,10 @@ pub fn run(args: CompensationArgs) -> anyhow::Result<()> {
         points: args.points,
     };
     let table = CompensationTable::of(&machine, &spec)?;
-    write_output(&args.out, table.to_csv().as_bytes(), &[&args.machine])?;
     for c in &table.coefficients {
         let worst = c.worst_residual_um_s2_per_m;
         if worst > WARN_RESIDUAL && worst > 0.1 * c.offset_um_s2_per_m.abs() {
-            eprintln!(
+            errln!(
                 "warning: {}: the linear form in {} leaves up to {worst:.3} µm·s²/m over the \
                  workspace (offset {:.3}): a compensation with one adaptation axis follows it only \
                  partly (see `eij map` for where it changes)",
@@ -57,7 +56,7 @@ pub fn run(args: CompensationArgs) -> anyhow::Result<()> {
             );
         }
     }
-    println!(
+    outln!(
         "Compensation of {} ({} circles per plane at {} m/s², r = {} mm, {} points per axis)",
         machine.name(),
         spec.points.pow(machine.axes().len() as u32),
@@ -65,12 +64,16 @@ pub fn run(args: CompensationArgs) -> anyhow::Result<()> {
         spec.radius_mm,
         spec.points
     );
-    println!(
+    outln!(
         "  {:<5} {:<5} {:>12} {:>16} {:>14}",
-        "EIJ", "axis", "offset", "slope per mm", "worst resid."
+        "EIJ",
+        "axis",
+        "offset",
+        "slope per mm",
+        "worst resid."
     );
     for c in &table.coefficients {
-        println!(
+        outln!(
             "  {:<5} {:<5} {:>12.4} {:>16.6} {:>14.4}",
             c.parameter.name(),
             c.adaptation_axis
@@ -80,5 +83,6 @@ pub fn run(args: CompensationArgs) -> anyhow::Result<()> {
             c.worst_residual_um_s2_per_m
         );
     }
-    Ok(())
+    // Printing only collects (`console`): the table is written before anything is shown.
+    write_output(&args.out, table.to_csv().as_bytes(), &[&args.machine])
 }

@@ -141,21 +141,21 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<()> {
         .iter()
         .flat_map(|t| t.result.warnings.iter().map(move |w| (t, w)))
     {
-        eprintln!(
+        errln!(
             "eij: warning: {}: {}",
             w.0.input.name(),
             super::advice::evaluate_warning(w.1)
         );
     }
     for w in &suite.warnings {
-        eprintln!("eij: warning: {w}");
+        errln!("eij: warning: {w}");
     }
     if args.json {
         let mut doc = suite.to_json_map();
         if let Some(p) = &pooled {
             doc.insert("pooled".into(), p.to_json());
         }
-        println!("{}", serde_json::Value::Object(doc));
+        outln!("{}", serde_json::Value::Object(doc));
     } else {
         let mut text = String::new();
         for t in &suite.tests {
@@ -165,7 +165,11 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<()> {
         if let Some(p) = &pooled {
             render_pooled(&mut text, p);
         }
-        print!("{text}");
+        out!("{text}");
+    }
+    if !files.is_empty() {
+        let written: Vec<&Path> = files.iter().map(|(p, _)| *p).collect();
+        super::console::wrote(&written);
     }
     Ok(())
 }

@@ -22,19 +22,24 @@ pub struct EvaluateMoveArgs {
 pub fn run(args: EvaluateMoveArgs) -> anyhow::Result<()> {
     let m = evaluate_move(&args.file, args.axis)?;
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&m.to_json())?);
+        outln!("{}", serde_json::to_string_pretty(&m.to_json())?);
         return Ok(());
     }
-    println!(
+    outln!(
         "{}: move of {} ({} samples, peak set acceleration {:.3} m/s²)",
-        m.source, m.axis, m.samples, m.peak_accel_m_s2
+        m.source,
+        m.axis,
+        m.samples,
+        m.peak_accel_m_s2
     );
-    println!(
+    outln!(
         "  {:<5} {:>10} {:>10}   (µm·s²/m)",
-        "EIJ", "value", "std err"
+        "EIJ",
+        "value",
+        "std err"
     );
     for ((e, v), s) in m.eij.iter().zip(m.std_err.values()) {
-        println!("  {:<5} {:>10.4} {:>10.4}", e.name(), v, s);
+        outln!("  {:<5} {:>10.4} {:>10.4}", e.name(), v, s);
     }
     Ok(())
 }

@@ -93,10 +93,6 @@ pub struct IdentifyArgs {
     /// test, cost over iterations) as SVG.
     #[arg(long, value_name = "FILE.svg")]
     plot: Option<PathBuf>,
-    /// No progress bar and nothing on standard output; warnings and errors still go to
-    /// standard error.
-    #[arg(long)]
-    quiet: bool,
     /// Also print the full tables: every measured and simulated EIJ with their ratios, the
     /// correlation matrix, every static term, clock offset and candidate test.
     #[arg(long, visible_alias = "verbose", conflicts_with = "quiet")]
@@ -219,7 +215,7 @@ fn prepare(
             .iter()
             .map(|p| p.display().to_string())
             .collect(),
-    );
+    )?;
     Ok(Prepared {
         problem,
         provenance,
@@ -267,7 +263,7 @@ fn run_identification(prep: &Prepared, quiet: bool) -> anyhow::Result<(IdentResu
             .map(|w| super::advice::identify_warning(w)),
     );
     for w in &result.warnings {
-        eprintln!("warning: {w}");
+        errln!("warning: {w}");
     }
     Ok((result, start.elapsed().as_secs_f64()))
 }
@@ -288,6 +284,8 @@ fn file_stem(name: &str) -> String {
 
 /// Runs `eij identify`.
 pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
+    // The date the outputs carry is checked before any work.
+    report::utc_timestamp()?;
     let mut config = match &args.config {
         Some(c) => IdentConfig::from_file(c)?,
         None => IdentConfig::default(),
@@ -374,7 +372,7 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
     } else {
         Some(measured::load(&args.validate, &prep.measured_options)?)
     };
-    let (result, seconds) = run_identification(&prep, args.quiet)?;
+    let (result, seconds) = run_identification(&prep, super::console::quiet())?;
     let validation = match validation_tests {
         Some(tests) => Some(check_validation(&prep, &result, tests)?),
         None => None,
@@ -382,7 +380,7 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
     let mut ident_report = report::IdentReport::new(&prep.problem, &result, &prep.provenance);
     ident_report.validation = validation.as_ref().map(Into::into);
     ident_report.clocks = prep.clocks.iter().map(Into::into).collect();
-    if !args.quiet {
+    if !super::console::quiet() {
         let tables = args.tables;
         super::identify_print::print_result(&prep.problem, &result, &ident_report, seconds, tables);
         super::identify_print::print_clocks(&prep.clocks, tables);
@@ -390,7 +388,7 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
             super::identify_print::print_validation(v, tables);
         }
         if !tables {
-            println!(
+            outln!(
                 "\nfull tables (every EIJ measured and simulated, correlations, static terms, candidate tests, clocks): --tables;\n\
                  all of it is in the report JSON, and `eij report --identify-report` shows it as a page"
             );
@@ -430,20 +428,7 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
     if let (Some(path), Some(svg)) = (&args.plot, &svg) {
         files.push((path, svg.as_bytes()));
     }
-    write_outputs(&files, &input_refs)?;
-    if !args.quiet {
-        let table = args
-            .stiffness_out
-            .as_ref()
-            .map(|p| format!(" (stiffness table {})", p.display()))
-            .unwrap_or_default();
-        println!(
-            "\nwrote {} and {}{table}",
-            out.display(),
-            report_path.display()
-        );
-    }
-    Ok(())
+    write_outputs(&files, &input_refs)
 }
 
 /// Validates the identified machine on the held-out tests; a failed validation is a warning.
@@ -455,7 +440,7 @@ fn check_validation(
     let v = validation::validate(&result.machine, tests, prep.problem.settings())
         .map_err(super::advice::identify)?;
     if !v.passed {
-        eprintln!(
+        errln!(
             "warning: hold-out validation failed: the identified model does not predict the {} held-out value(s) within their measurement uncertainty (χ²/dof = {:.2} over {} degrees of freedom)",
             v.values, v.chi2_per_dof, v.dof
         );
@@ -484,8 +469,9 @@ pub fn verify(args: VerifyArgs) -> anyhow::Result<()> {
     for f in &files {
         let outcome = verify_one(f)?;
         for line in &outcome {
-            println!("{line}");
+            outln!("{line}");
         }
+        super::console::flush();
         failures.extend(outcome.into_iter().filter(|l| l.starts_with("FAIL")));
     }
     if !failures.is_empty() {

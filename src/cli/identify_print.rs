@@ -40,7 +40,7 @@ pub(super) fn print_result(
         print_design(d, tables);
     }
     for n in &result.notes {
-        println!("note: {n}");
+        outln!("note: {n}");
     }
 }
 
@@ -51,7 +51,7 @@ fn print_verdict(p: &Problem, result: &IdentResult, report: &IdentReport, second
     } else {
         "Identified"
     };
-    println!(
+    outln!(
         "{verb} {} from {} tests ({} values), {} iterations, {:.1} s",
         p.machine().name(),
         p.tests().len(),
@@ -59,14 +59,16 @@ fn print_verdict(p: &Problem, result: &IdentResult, report: &IdentReport, second
         result.iterations,
         seconds
     );
-    println!(
+    outln!(
         "cost Σr² {:.4e} -> {:.4e}   residual std s = {:.3}   (r = (simulated − measured EIJ) / σ)",
-        result.cost_initial, result.cost_final, result.residual_std
+        result.cost_initial,
+        result.cost_final,
+        result.residual_std
     );
     if let Some(c) = report.chi2() {
-        println!("χ² test {}", c.describe());
+        outln!("χ² test {}", c.describe());
     }
-    println!("\n  parameter              initial   identified    std err   σ/value  standing");
+    outln!("\n  parameter              initial   identified    std err   σ/value  standing");
     for q in &report.parameters {
         let standing = report.standing(q);
         let rel = standing
@@ -78,7 +80,7 @@ fn print_verdict(p: &Problem, result: &IdentResult, report: &IdentReport, second
             ""
         };
         match q.std_err {
-            Some(s) => println!(
+            Some(s) => outln!(
                 "  {:<22} {:>7.4}   {:>10.4}   {:>8.4}  {:>8}  {}{plausible}",
                 q.name,
                 q.initial,
@@ -87,7 +89,7 @@ fn print_verdict(p: &Problem, result: &IdentResult, report: &IdentReport, second
                 rel,
                 standing.label()
             ),
-            None => println!(
+            None => outln!(
                 "  {:<22} {:>7.4}   {:>10.4}   {:>8}  {:>8}  {} (kept at its start value)",
                 q.name,
                 q.initial,
@@ -100,7 +102,7 @@ fn print_verdict(p: &Problem, result: &IdentResult, report: &IdentReport, second
     }
     let legend = Standing::legend();
     let (a, b) = legend.split_once("; ").unwrap_or((&legend, ""));
-    println!("  ({a};\n   {b})");
+    outln!("  ({a};\n   {b})");
     let n = result.parameters.len();
     let strong: Vec<String> = (0..n)
         .flat_map(|i| (i + 1..n).map(move |k| (i, k)))
@@ -115,14 +117,14 @@ fn print_verdict(p: &Problem, result: &IdentResult, report: &IdentReport, second
         })
         .collect();
     if !strong.is_empty() {
-        println!(
+        outln!(
             "  strongly correlated (|r| ≥ {STRONG_CORRELATION}): {}",
             strong.join(", ")
         );
     }
     match result.warnings.len() {
-        0 => println!("\nwarnings: none"),
-        k => println!("\nwarnings: {k} (on standard error above; also in the report JSON)"),
+        0 => outln!("\nwarnings: none"),
+        k => outln!("\nwarnings: {k} (on standard error above; also in the report JSON)"),
     }
 }
 
@@ -132,23 +134,23 @@ fn print_correlation(result: &IdentResult) {
     if n < 2 {
         return;
     }
-    println!("\n  correlation of the identified parameters");
+    outln!("\n  correlation of the identified parameters");
     for i in 0..n {
         let row: Vec<String> = (0..n)
             .map(|k| format!("{:>6.2}", result.correlation[(i, k)]))
             .collect();
-        println!("  {:<22} {}", result.parameters[i].name, row.join(" "));
+        outln!("  {:<22} {}", result.parameters[i].name, row.join(" "));
     }
 }
 
 /// Every measured EIJ beside its simulation before and after, with the ratios.
 fn print_eij_table(p: &Problem, result: &IdentResult) {
-    println!(
+    outln!(
         "\n  every EIJ, µm·s²/m: measured ± σ (the test's evaluation and its standard error), simulated with the\n  \
          catalogue (start) factors and with the identified ones; (ratio) = simulated / measured where |measured| > {RATIO_SIGMAS}σ,\n  \
          '-' where the measured value is zero within {RATIO_SIGMAS}σ (a ratio to it means nothing)"
     );
-    println!(
+    outln!(
         "  {:<36} EIJ   measured ± σ       catalogue (ratio)   identified (ratio)",
         "test"
     );
@@ -166,7 +168,7 @@ fn print_eij_table(p: &Problem, result: &IdentResult) {
                     "    -".to_string()
                 }
             };
-            println!(
+            outln!(
                 "  {:<36} {} {:>8.3} ± {:<6.3}  {:>8.3} ({})     {:>8.3} ({})",
                 t.label(),
                 e,
@@ -220,7 +222,7 @@ fn print_groups(p: &Problem, result: &IdentResult) {
             None => groups.push((key, 1, z)),
         }
     }
-    println!(
+    outln!(
         "\n  per plane and circle centre: z = (identified model − measured) / σ over the EIJ of its tests\n  \
          {:<28} tests  values  rms z  max |z| (test, EIJ)",
         "plane @ circle centre"
@@ -232,7 +234,7 @@ fn print_groups(p: &Problem, result: &IdentResult) {
             .max_by(|a, b| a.0.abs().total_cmp(&b.0.abs()))
             .map(|(v, l)| format!("{:.1} ({l})", v.abs()))
             .unwrap_or_default();
-        println!(
+        outln!(
             "  {:<28} {:>5}  {:>6}  {:>5.2}  {}",
             key,
             n,
@@ -267,7 +269,7 @@ fn print_ratios(p: &Problem, result: &IdentResult) {
         v.sort_by(f64::total_cmp);
         v[v.len() / 2]
     };
-    println!(
+    outln!(
         "\nsimulated/measured over the {} values beyond {RATIO_SIGMAS}σ: median {:.2} with the catalogue model, {:.2} identified",
         before.len(),
         median(&mut before),
@@ -288,7 +290,7 @@ fn print_statics(result: &IdentResult, tables: bool) {
     else {
         return;
     };
-    println!(
+    outln!(
         "\n  static terms (geometry fitted with the EIJ, µm per mm of set position): {} in {} groups, largest {} {:+.3} ± {:.3} ({})",
         terms.len(),
         result.statics.groups.len(),
@@ -315,7 +317,7 @@ fn print_statics(result: &IdentResult, tables: bool) {
             })
             .collect();
         if !terms.is_empty() {
-            println!("  {:<28} {}", group.label(), terms.join("  "));
+            outln!("  {:<28} {}", group.label(), terms.join("  "));
         }
     }
 }
@@ -330,7 +332,7 @@ fn print_fitted_clocks(result: &IdentResult, tables: bool) {
     }) else {
         return;
     };
-    println!(
+    outln!(
         "  clock offsets fitted with the EIJ (external readings late): {}, largest {:+.4} ± {:.4} ms ({})",
         fitted.len(),
         largest.external_late_ms,
@@ -339,9 +341,11 @@ fn print_fitted_clocks(result: &IdentResult, tables: bool) {
     );
     if tables {
         for c in &fitted {
-            println!(
+            outln!(
                 "  {:<40} {:+.4} ± {:.4} ms",
-                c.clock, c.external_late_ms, c.std_err_ms
+                c.clock,
+                c.external_late_ms,
+                c.std_err_ms
             );
         }
     }
@@ -371,7 +375,7 @@ fn print_design(d: &Design, tables: bool) {
         )
     };
     if !tables {
-        println!(
+        outln!(
             "  best additional test (of {} candidates): {} -> worst σ/value {:.1} % → {:.1} % ({})",
             d.evaluated,
             label(best).trim_end(),
@@ -381,14 +385,14 @@ fn print_design(d: &Design, tables: bool) {
         );
         return;
     }
-    println!(
+    outln!(
         "\n  candidate additional tests ({} evaluated), ranked by the worst relative standard error they leave (now {} at {:.1} %)",
         d.evaluated,
         name,
         100.0 * now
     );
     for (k, c) in d.candidates.iter().enumerate() {
-        println!(
+        outln!(
             "  {:>2}. {} -> worst {:.1} % ({})",
             k + 1,
             label(c),
@@ -400,7 +404,7 @@ fn print_design(d: &Design, tables: bool) {
 
 /// The hold-out validation: the verdict, with `tables` one line per test.
 pub(super) fn print_validation(v: &Validation, tables: bool) {
-    println!(
+    outln!(
         "\n  hold-out validation: {} values, χ²/dof = {:.2} ({})",
         v.values,
         v.chi2_per_dof,
@@ -413,14 +417,18 @@ pub(super) fn print_validation(v: &Validation, tables: bool) {
     if !tables {
         return;
     }
-    println!(
+    outln!(
         "  {:<40} rms z   max |z|   rms error   rms σ  (µm·s²/m; z = (predicted − measured)/σ)",
         "test"
     );
     for t in &v.tests {
-        println!(
+        outln!(
             "  {:<40} {:>5.2}   {:>7.2}   {:>9.4}   {:>6.4}",
-            t.label, t.rms_z, t.max_abs_z, t.rms_error_um_s2_per_m, t.rms_sigma_um_s2_per_m
+            t.label,
+            t.rms_z,
+            t.max_abs_z,
+            t.rms_error_um_s2_per_m,
+            t.rms_sigma_um_s2_per_m
         );
     }
 }
@@ -431,7 +439,7 @@ pub(super) fn print_clocks(clocks: &[eij::rtest::suite::ClockReport], tables: bo
         return;
     }
     let applied = clocks.iter().filter(|c| c.applied).count();
-    println!(
+    outln!(
         "  clock offsets estimated by the evaluation (internal minus external clock): {}, {applied} applied",
         clocks.len()
     );
@@ -443,7 +451,7 @@ pub(super) fn print_clocks(clocks: &[eij::rtest::suite::ClockReport], tables: bo
             .std_err_ms
             .map(|s| format!(" ± {s:.4}"))
             .unwrap_or_default();
-        println!(
+        outln!(
             "  {:<40} {:+.4}{se} ms  {} tests, {}",
             c.clock,
             c.offset_ms,

@@ -69,12 +69,14 @@ pub fn write_output(
 }
 
 /// Writes the outputs of a run as one set ([`eij::io::write_set`]): all or none, never
-/// replacing any of `inputs` or any file the run has read.
+/// replacing any of `inputs` or any file the run has read; then says what it wrote.
 pub fn write_outputs(
     files: &[(&std::path::Path, &[u8])],
     inputs: &[&std::path::Path],
 ) -> anyhow::Result<()> {
     eij::io::write_set(files, inputs)?;
+    let written: Vec<&std::path::Path> = files.iter().map(|(p, _)| *p).collect();
+    super::console::wrote(&written);
     Ok(())
 }
 

@@ -2,8 +2,33 @@
 
 use clap::{Parser, Subcommand};
 
+/// `println!` into the run's standard output, written once the run's files are ([`console`]).
+macro_rules! outln {
+    () => {
+        crate::cli::console::print(format_args!("\n"))
+    };
+    ($($arg:tt)*) => {
+        crate::cli::console::print(format_args!("{}\n", format_args!($($arg)*)))
+    };
+}
+
+/// `print!` into the run's standard output ([`console`]).
+macro_rules! out {
+    ($($arg:tt)*) => {
+        crate::cli::console::print(format_args!($($arg)*))
+    };
+}
+
+/// `eprintln!` that never panics and escapes control characters ([`console`]).
+macro_rules! errln {
+    ($($arg:tt)*) => {
+        crate::cli::console::error_line(format_args!($($arg)*))
+    };
+}
+
 mod advice;
 mod compensation;
+pub mod console;
 pub mod evaluate;
 mod evaluate_move;
 mod export;
@@ -22,6 +47,10 @@ mod stiffness;
 pub struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Nothing on standard output, no progress bar and no status line; warnings and errors
+    /// still go to standard error.
+    #[arg(long, short, global = true)]
+    quiet: bool,
 }
 
 #[derive(Debug, Subcommand)]
@@ -56,6 +85,7 @@ impl Cli {
     pub fn run(self) -> anyhow::Result<()> {
         // One run per process: every file it reads is an input no output may replace.
         eij::io::track_inputs();
+        console::set_quiet(self.quiet);
         match self.command {
             Command::Evaluate(args) => evaluate::run(args),
             Command::EvaluateMove(args) => evaluate_move::run(args),

@@ -42,10 +42,10 @@ pub fn run(args: ModalArgs) -> anyhow::Result<()> {
                 "dominant_share": m.dominant_share,
             })).collect::<Vec<_>>(),
         });
-        println!("{out}");
+        outln!("{out}");
         return Ok(());
     }
-    println!(
+    outln!(
         "Undamped modes of {} at {} (rigid-body modes of the drives at 0 Hz)",
         machine.name(),
         machine
@@ -56,12 +56,15 @@ pub fn run(args: ModalArgs) -> anyhow::Result<()> {
             .collect::<Vec<_>>()
             .join(", ")
     );
-    println!(
+    outln!(
         "{:>4}  {:>10}  {:<14} {:>6}",
-        "mode", "f / Hz", "dominant DOF", "share"
+        "mode",
+        "f / Hz",
+        "dominant DOF",
+        "share"
     );
     for (i, m) in modes.iter().enumerate() {
-        println!(
+        outln!(
             "{:>4}  {:>10.2}  {:<14} {:>5.0}%",
             i + 1,
             m.frequency_hz,

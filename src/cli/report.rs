@@ -42,10 +42,10 @@ pub fn run(args: ReportArgs) -> anyhow::Result<()> {
         extra_figures: map_figures(&args.maps)?,
         out_dir: args.out,
     })?;
-    eprintln!(
-        "report: wrote {} (one page, figures inline)",
+    super::console::status(format_args!(
+        "wrote {} (one page, figures inline)",
         page.display()
-    );
+    ));
     Ok(())
 }
 

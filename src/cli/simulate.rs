@@ -1,7 +1,7 @@
 //! `eij simulate circle|move …`: closed-loop time-domain simulation to an R-Test-like CSV.
 
 use super::machine_args::{write_outputs, MachineArgs};
-use anyhow::bail;
+use anyhow::{bail, Context};
 use eij::axes::{Axis, Direction, Plane};
 use eij::compensation::{Compensated, CompensationTable};
 use eij::control::ClosedLoop;
@@ -245,14 +245,14 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
             check_samples(&m.common, &mv, None)?;
             run_move(&m.common, &mv)?;
             // After the run, so that a refused move gives one error line only.
-            eprintln!(
+            super::console::status(format_args!(
                 "move {}: {:.3} mm, peak velocity {:.4} m/s, peak set acceleration {:.3} m/s², {:.4} s",
                 m.axis,
                 m.distance_mm,
                 mv.peak_velocity_m_s,
                 mv.peak_accel_m_s2,
                 mv.motion_s()
-            );
+            ));
             Ok(())
         }
     }
@@ -372,13 +372,17 @@ fn stream_csv(
         Some(c) => c,
         None => sp,
     };
+    // A write that fails (a full disk) names the output.
+    let cannot_write = || format!("{}: cannot write", common.out.display());
     eij::sim::simulate_blocks(cl, setpoint, rate, |block| -> anyhow::Result<()> {
         let correction = comp.map(|c| corrections(c, cl, block));
-        csv.write(block, correction.as_deref())?;
+        csv.write(block, correction.as_deref())
+            .with_context(cannot_write)?;
         Ok(())
     })?;
-    csv.finish()?;
+    csv.finish().with_context(cannot_write)?;
     out.commit()?;
+    super::console::wrote(&[&common.out]);
     Ok(())
 }
 

@@ -26,12 +26,12 @@ pub fn run(args: StiffnessArgs) -> anyhow::Result<()> {
     }
     let (table, warnings) = machine_table(&machine);
     for w in &warnings {
-        eprintln!("warning: {w}");
+        errln!("warning: {w}");
     }
     match &args.out {
         Some(out) => write_output(out, &table.to_csv(), &[args.machine.as_path()]),
         None => {
-            print!("{}", text(&machine, &table));
+            out!("{}", text(&machine, &table));
             Ok(())
         }
     }

@@ -26,25 +26,55 @@ pub struct Provenance {
 }
 
 impl Provenance {
-    /// Provenance with the current (or SOURCE_DATE_EPOCH) time.
-    pub fn now(machine_file: String, measured: Vec<String>) -> Self {
-        Provenance {
+    /// Provenance with the current (or SOURCE_DATE_EPOCH) time; an error where
+    /// SOURCE_DATE_EPOCH is set but is not a time ([`utc_timestamp`]).
+    pub fn now(machine_file: String, measured: Vec<String>) -> Result<Self, SourceDateError> {
+        Ok(Provenance {
             machine_file,
             measured,
-            date: utc_timestamp(),
-        }
+            date: utc_timestamp()?,
+        })
     }
 }
 
-/// The current UTC time (RFC 3339, seconds), or SOURCE_DATE_EPOCH when set, for reproducible
-/// outputs.
-pub fn utc_timestamp() -> String {
-    let time = std::env::var("SOURCE_DATE_EPOCH")
-        .ok()
-        .and_then(|s| s.trim().parse::<u64>().ok())
-        .map(|s| std::time::UNIX_EPOCH + std::time::Duration::from_secs(s))
-        .unwrap_or_else(std::time::SystemTime::now);
-    humantime::format_rfc3339_seconds(time).to_string()
+/// The latest SOURCE_DATE_EPOCH written: 9999-12-31T23:59:59Z (RFC 3339 has four-digit years).
+pub const MAX_SOURCE_DATE_EPOCH: u64 = 253_402_300_799;
+
+/// SOURCE_DATE_EPOCH is set but is not a time stamp eij can write.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("SOURCE_DATE_EPOCH={value:?}: {why}; it must be whole seconds since 1970-01-01 UTC, 0…{MAX_SOURCE_DATE_EPOCH} (unset it to use the current time)")]
+pub struct SourceDateError {
+    /// The variable's value.
+    pub value: String,
+    /// What is wrong with it.
+    pub why: &'static str,
+}
+
+/// The current UTC time (RFC 3339, seconds), or, for reproducible outputs, SOURCE_DATE_EPOCH
+/// where it is set (and not empty), following the reproducible-builds convention: a
+/// malformed value is an error, never silently replaced by the current time.
+pub fn utc_timestamp() -> Result<String, SourceDateError> {
+    let time = match std::env::var_os("SOURCE_DATE_EPOCH") {
+        Some(v) if !v.is_empty() => {
+            let value = v.to_string_lossy().into_owned();
+            let bad = |why| SourceDateError {
+                value: value.clone(),
+                why,
+            };
+            let digits = value.trim();
+            if digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit()) {
+                return Err(bad("not a whole number of seconds"));
+            }
+            let s: u64 = digits
+                .parse()
+                .ok()
+                .filter(|s| *s <= MAX_SOURCE_DATE_EPOCH)
+                .ok_or_else(|| bad("after the year 9999 (milliseconds given for seconds?)"))?;
+            std::time::UNIX_EPOCH + std::time::Duration::from_secs(s)
+        }
+        _ => std::time::SystemTime::now(),
+    };
+    Ok(humantime::format_rfc3339_seconds(time).to_string())
 }
 
 /// EIJ values by parameter, µm·s²/m. A value a simulation lacks is NaN, written as `null`.

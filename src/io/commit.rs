@@ -1,27 +1,29 @@
 //! Committing the outputs of a run together.
 //!
-//! 1. Every new file is written in full to a temporary file beside its target,
-//!    `.eij-<pid>-<n>.tmp` (short, whatever the target's name: a 255-byte name still fits),
-//!    with the permissions and owner of the file it replaces, and synced.
-//! 2. For more than one file, a journal `.eij-<pid>-<n>.commit` listing the renames is written
+//! 1. The output folders are locked ([`FolderLocks`]: a concurrent run waits), and what a
+//!    killed run left there for these outputs is recovered ([`recover`]).
+//! 2. Every new file is written in full to a temporary file beside its target,
+//!    `.eij-<pid>-<n>-<h>.tmp` (short, whatever the target's name: a 255-byte name still fits;
+//!    `<h>` ties it to its target), with the permissions and owner of the file it replaces,
+//!    and synced.
+//! 3. For more than one file, a journal `.eij-<pid>-<n>.commit` listing the renames is written
 //!    into every folder involved, and synced.
-//! 3. The temporary files are renamed over their targets, the folders synced, the journals
-//!    removed.
+//! 4. The temporary files are renamed over their targets, the folders synced, the journals
+//!    removed, the folders unlocked.
 //!
-//! Interrupt, terminate and hang-up signals that arrive during 1–3 are held until the commit
-//! ends, so such a kill leaves the old set (before 1) or the new set. Only a SIGKILL or a power
-//! loss can stop the commit half-way: then the next commit into one of those folders finds the
+//! Interrupt, terminate and hang-up signals that arrive during 2–4 are held until the commit
+//! ends, so such a kill leaves the old set (before 2) or the new set. Only a SIGKILL or a power
+//! loss can stop the commit half-way: then the next commit of one of those outputs finds the
 //! journal of the dead process and completes its renames (or, without a complete journal,
 //! removes its temporary files), before writing its own outputs ([`recover`]).
 
+pub use super::journal::recover;
+use super::journal::{name_hash, FolderLocks, Journal, PREFIX};
 use super::{check_outputs, folder_of, WriteError};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
-
-/// Prefix of every temporary name, for [`recover`] to find them.
-const PREFIX: &str = ".eij-";
 
 /// Numbers the temporary names of one process.
 static NEXT: AtomicUsize = AtomicUsize::new(0);
@@ -29,9 +31,15 @@ static NEXT: AtomicUsize = AtomicUsize::new(0);
 /// One commit at a time per process (the signal handling is process-wide).
 static COMMIT: Mutex<()> = Mutex::new(());
 
-fn temp_name(dir: &Path, ext: &str) -> PathBuf {
+fn next_name(dir: &Path, tail: &str) -> PathBuf {
     let n = NEXT.fetch_add(1, Ordering::SeqCst);
-    dir.join(format!("{PREFIX}{}-{n}.{ext}", std::process::id()))
+    dir.join(format!("{PREFIX}{}-{n}{tail}", std::process::id()))
+}
+
+/// A new temporary name for the output `target`, in its folder.
+fn temp_name(target: &Path) -> PathBuf {
+    let hash = name_hash(target.file_name().unwrap_or_default());
+    next_name(&folder_of(target), &format!("-{hash}.tmp"))
 }
 
 /// Checks that the folder of `path` takes new files, by creating and removing one.
@@ -39,7 +47,7 @@ pub(super) fn probe_folder(path: &Path) -> Result<(), WriteError> {
     // Like a commit: a kill between creating and removing the probe would leave it behind.
     let _one = COMMIT.lock().unwrap_or_else(|e| e.into_inner());
     let _held = signals::Held::new();
-    let probe = temp_name(&folder_of(path), "tmp");
+    let probe = temp_name(path);
     std::fs::OpenOptions::new()
         .write(true)
         .create_new(true)
@@ -50,13 +58,6 @@ pub(super) fn probe_folder(path: &Path) -> Result<(), WriteError> {
         })?;
     let _ = std::fs::remove_file(&probe);
     Ok(())
-}
-
-/// The journal of a commit: the renames, and every folder holding a copy of it.
-#[derive(serde::Serialize, serde::Deserialize)]
-struct Journal {
-    renames: Vec<(PathBuf, PathBuf)>,
-    copies: Vec<PathBuf>,
 }
 
 /// Writes every `(path, bytes)` as one set (module docs): after an error, nothing of the set is
@@ -74,9 +75,11 @@ pub fn write_set(files: &[(&Path, &[u8])], inputs: &[&Path]) -> Result<(), Write
             folders.push(d);
         }
     }
+    let targets: Vec<PathBuf> = paths.iter().map(|p| target_of(p)).collect();
     let _one = COMMIT.lock().unwrap_or_else(|e| e.into_inner());
+    let _locks = FolderLocks::new(&folders);
     for d in &folders {
-        recover(d);
+        recover(d, &targets);
     }
     let _held = signals::Held::new();
     let mut staged: Vec<(PathBuf, PathBuf)> = Vec::new();
@@ -88,9 +91,9 @@ pub fn write_set(files: &[(&Path, &[u8])], inputs: &[&Path]) -> Result<(), Write
             let _ = std::fs::remove_file(j);
         }
     };
-    for (path, bytes) in files {
-        let target = target_of(path);
-        let tmp = temp_name(&folder_of(&target), "tmp");
+    for ((path, bytes), target) in files.iter().zip(&targets) {
+        let target = target.clone();
+        let tmp = temp_name(&target);
         if let Err(cause) = stage(&tmp, &target, bytes) {
             let _ = std::fs::remove_file(&tmp);
             remove_all(&staged, &[]);
@@ -185,7 +188,7 @@ impl StreamedOutput {
     pub fn create(path: &Path, inputs: &[&Path]) -> Result<StreamedOutput, WriteError> {
         check_outputs(&[path], inputs)?;
         let target = target_of(path);
-        let tmp = temp_name(&folder_of(&target), "tmp");
+        let tmp = temp_name(&target);
         let file = open_staged(&tmp, &target).map_err(|cause| {
             let _ = std::fs::remove_file(&tmp);
             WriteError::Io {
@@ -217,7 +220,8 @@ impl StreamedOutput {
         self.file.get_ref().sync_all().map_err(io_err)?;
         let folder = folder_of(&self.target);
         let _one = COMMIT.lock().unwrap_or_else(|e| e.into_inner());
-        recover(&folder);
+        let _lock = FolderLocks::new(std::slice::from_ref(&folder));
+        recover(&folder, std::slice::from_ref(&self.target));
         let _held = signals::Held::new();
         std::fs::rename(&self.tmp, &self.target).map_err(io_err)?;
         sync_folder(&folder);
@@ -238,7 +242,7 @@ fn write_journals(
     staged: &[(PathBuf, PathBuf)],
     folders: &[PathBuf],
 ) -> std::io::Result<Vec<PathBuf>> {
-    let copies: Vec<PathBuf> = folders.iter().map(|d| temp_name(d, "commit")).collect();
+    let copies: Vec<PathBuf> = folders.iter().map(|d| next_name(d, ".commit")).collect();
     let text = serde_json::to_vec(&Journal {
         renames: staged.to_vec(),
         copies: copies.clone(),
@@ -266,85 +270,6 @@ fn write_journals(
 fn sync_folder(dir: &Path) {
     if let Ok(f) = std::fs::File::open(dir) {
         let _ = f.sync_all();
-    }
-}
-
-/// The process id in a temporary name `.eij-<pid>-<n>.<ext>`.
-fn owner(name: &str) -> Option<u32> {
-    name.strip_prefix(PREFIX)?.split('-').next()?.parse().ok()
-}
-
-/// Whether process `pid` still runs (then its temporary files are left alone).
-fn alive(pid: u32) -> bool {
-    if pid == std::process::id() {
-        return true;
-    }
-    #[cfg(unix)]
-    {
-        let Ok(p) = libc::pid_t::try_from(pid) else {
-            return false;
-        };
-        // SAFETY: signal 0 only checks that the process exists.
-        let r = unsafe { libc::kill(p, 0) };
-        r == 0 || std::io::Error::last_os_error().raw_os_error() == Some(libc::EPERM)
-    }
-    #[cfg(not(unix))]
-    {
-        true
-    }
-}
-
-/// Completes or undoes what a killed eij left in `dir`: a journal whose copies were all
-/// written is carried out (its temporary files become the new set), any other journal's
-/// temporary files are removed, and so is every other temporary file of a process that no
-/// longer runs. Called by every commit for its folders.
-pub fn recover(dir: &Path) {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return;
-    };
-    let stale: Vec<PathBuf> = entries
-        .filter_map(|e| e.ok())
-        .filter(|e| {
-            let name = e.file_name();
-            let name = name.to_string_lossy();
-            owner(&name).is_some_and(|pid| !alive(pid))
-        })
-        .map(|e| e.path())
-        .collect();
-    let read = |p: &Path| {
-        std::fs::read(p)
-            .ok()
-            .and_then(|b| serde_json::from_slice::<Journal>(&b).ok())
-    };
-    for j in stale
-        .iter()
-        .filter(|p| p.extension().is_some_and(|x| x == "commit"))
-    {
-        if let Some(journal) = read(j) {
-            // Committed only once every copy was written in full: then the renames are
-            // completed, else the new files are dropped and the old set stays.
-            let committed = journal
-                .copies
-                .iter()
-                .all(|c| read(c).is_some_and(|o| o.renames == journal.renames));
-            for (tmp, target) in &journal.renames {
-                if committed && tmp.is_file() {
-                    let _ = std::fs::rename(tmp, target);
-                } else {
-                    let _ = std::fs::remove_file(tmp);
-                }
-            }
-            for c in &journal.copies {
-                let _ = std::fs::remove_file(c);
-            }
-        }
-        let _ = std::fs::remove_file(j);
-    }
-    for t in stale
-        .iter()
-        .filter(|p| p.extension().is_some_and(|x| x == "tmp"))
-    {
-        let _ = std::fs::remove_file(t);
     }
 }
 
@@ -441,12 +366,23 @@ mod tests {
         v
     }
 
+    /// The temporary name a dead process gave output `name` in `dir`.
+    fn dead_temporary(dir: &Path, n: u32, name: &str) -> PathBuf {
+        let hash = name_hash(std::ffi::OsStr::new(name));
+        dir.join(format!(".eij-{DEAD}-{n}-{hash}.tmp"))
+    }
+
+    /// The outputs `x` in `dir` and `y` in `dir/b`.
+    fn outputs(dir: &Path) -> [PathBuf; 2] {
+        [dir.join("x"), dir.join("b/y")]
+    }
+
     /// What a commit killed after writing its temporary files and `copies` of its journal
     /// leaves behind, for outputs `x` in `dir` and `y` in `dir/b`.
     fn killed_commit(dir: &Path, copies: usize) {
         let staged = [
-            (dir.join(format!(".eij-{DEAD}-1.tmp")), dir.join("x")),
-            (dir.join(format!("b/.eij-{DEAD}-2.tmp")), dir.join("b/y")),
+            (dead_temporary(dir, 1, "x"), dir.join("x")),
+            (dead_temporary(&dir.join("b"), 2, "y"), dir.join("b/y")),
         ];
         for (tmp, _) in &staged {
             std::fs::write(tmp, "new").unwrap();
@@ -473,8 +409,11 @@ mod tests {
             std::fs::write(dir.join("b/y"), "old").unwrap();
             killed_commit(&dir, 2);
             // The kill fell after the first rename.
-            std::fs::rename(dir.join(format!(".eij-{DEAD}-1.tmp")), dir.join("x")).unwrap();
-            recover(&if from_b { dir.join("b") } else { dir.clone() });
+            std::fs::rename(dead_temporary(&dir, 1, "x"), dir.join("x")).unwrap();
+            recover(
+                &if from_b { dir.join("b") } else { dir.clone() },
+                &outputs(&dir),
+            );
             assert_eq!(std::fs::read_to_string(dir.join("x")).unwrap(), "new");
             assert_eq!(std::fs::read_to_string(dir.join("b/y")).unwrap(), "new");
             assert_eq!(names(&dir), ["b", "x"]);
@@ -489,8 +428,8 @@ mod tests {
         std::fs::write(dir.join("x"), "old").unwrap();
         std::fs::write(dir.join("b/y"), "old").unwrap();
         killed_commit(&dir, 1);
-        recover(&dir);
-        recover(&dir.join("b"));
+        recover(&dir, &outputs(&dir));
+        recover(&dir.join("b"), &outputs(&dir));
         assert_eq!(std::fs::read_to_string(dir.join("x")).unwrap(), "old");
         assert_eq!(std::fs::read_to_string(dir.join("b/y")).unwrap(), "old");
         assert_eq!(names(&dir), ["b", "x"]);

@@ -5,6 +5,7 @@
 use std::path::{Path, PathBuf};
 
 mod commit;
+mod journal;
 pub mod read;
 
 pub use commit::{recover, write_set, StreamedOutput};
@@ -39,6 +40,15 @@ pub enum WriteError {
         kind: &'static str,
         /// What to give instead, where there is something.
         hint: &'static str,
+    },
+    /// The output exists but cannot be replaced by a new file (immutable, append-only, a
+    /// mount point, or another user's file in a folder with the sticky bit).
+    #[error("{path}: cannot be replaced: {why}")]
+    NotReplaceable {
+        /// The output path asked for.
+        path: PathBuf,
+        /// Why not.
+        why: &'static str,
     },
     /// The folder the output should go into does not exist.
     #[error("{path}: cannot write: folder {} does not exist", folder.display())]
@@ -100,6 +110,57 @@ fn special_kind(meta: &std::fs::Metadata) -> Option<(&'static str, &'static str)
     Some(("special file", ""))
 }
 
+/// Why the existing regular file `path` (metadata `meta`) could not be replaced by renaming a
+/// new file over it, where the system says so without trying: an immutable or append-only
+/// file, a mount point, or, in a folder with the sticky bit, a file of another user.
+fn not_replaceable(path: &Path, meta: &std::fs::Metadata) -> Option<&'static str> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        let folder = std::fs::metadata(folder_of(path)).ok()?;
+        if folder.dev() != meta.dev() {
+            return Some("it is a mount point");
+        }
+        // SAFETY: geteuid has no preconditions.
+        let me = unsafe { libc::geteuid() };
+        if folder.mode() & 0o1000 != 0 && me != 0 && me != meta.uid() && me != folder.uid() {
+            return Some("another user's file in a folder with the sticky bit");
+        }
+    }
+    #[cfg(all(target_os = "linux", any(target_env = "gnu", target_env = "musl")))]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        let c = std::ffi::CString::new(path.as_os_str().as_bytes()).ok()?;
+        // SAFETY: statx writes into a zeroed struct of the right type; the path is a valid
+        // C string; no link is followed.
+        let attributes = unsafe {
+            let mut x: libc::statx = std::mem::zeroed();
+            let r = libc::statx(
+                libc::AT_FDCWD,
+                c.as_ptr(),
+                libc::AT_SYMLINK_NOFOLLOW,
+                libc::STATX_BASIC_STATS,
+                &mut x,
+            );
+            if r != 0 {
+                return None;
+            }
+            x.stx_attributes & x.stx_attributes_mask
+        };
+        if attributes & libc::STATX_ATTR_IMMUTABLE as u64 != 0 {
+            return Some("it is immutable (chattr +i)");
+        }
+        if attributes & libc::STATX_ATTR_APPEND as u64 != 0 {
+            return Some("it is append-only (chattr +a)");
+        }
+        if attributes & libc::STATX_ATTR_MOUNT_ROOT as u64 != 0 {
+            return Some("it is a mount point");
+        }
+    }
+    let _ = (path, meta);
+    None
+}
+
 /// The path an output will have once written: its folder made absolute and without links,
 /// plus its name (for comparing outputs that do not exist yet).
 fn resolved(path: &Path) -> Option<PathBuf> {
@@ -135,6 +196,9 @@ pub fn check_outputs(outputs: &[&Path], inputs: &[&Path]) -> Result<(), WriteErr
                         hint,
                     });
                 }
+                if let Some(why) = not_replaceable(path, &m) {
+                    return Err(WriteError::NotReplaceable { path: out, why });
+                }
                 let id = FileId::of(path);
                 if let Some((_, input)) = known.iter().find(|(i, _)| Some(i) == id.as_ref()) {
                     let via = if input == *path {
@@ -145,12 +209,19 @@ pub fn check_outputs(outputs: &[&Path], inputs: &[&Path]) -> Result<(), WriteErr
                     return Err(WriteError::WouldClobberInput { path: out, via });
                 }
             }
-            Err(_) => {
+            Err(e) => {
                 let dir = folder_of(path);
                 if !dir.is_dir() {
                     return Err(WriteError::NoFolder {
                         path: out,
                         folder: dir,
+                    });
+                }
+                // A name too long, no permission to look: found now, not after the work.
+                if e.kind() != std::io::ErrorKind::NotFound {
+                    return Err(WriteError::Io {
+                        path: out,
+                        cause: e,
                     });
                 }
             }

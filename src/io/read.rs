@@ -98,6 +98,7 @@ pub fn record_input(path: &Path) {
 
 /// Reads a whole input file of at most `max_bytes` bytes. Devices and pipes are read like
 /// files, up to the limit; a missing path and a folder are told apart from other failures.
+/// Lines ending in CR alone come back ending in LF ([`unix_line_ends`]).
 pub fn read_input(path: &Path, max_bytes: u64) -> Result<Vec<u8>, ReadError> {
     let meta = std::fs::metadata(path).map_err(|e| match e.kind() {
         std::io::ErrorKind::NotFound => ReadError::NotFound,
@@ -118,7 +119,21 @@ pub fn read_input(path: &Path, max_bytes: u64) -> Result<Vec<u8>, ReadError> {
     if bytes.len() as u64 > max_bytes {
         return Err(ReadError::TooLarge { limit: max_bytes });
     }
-    Ok(bytes)
+    Ok(unix_line_ends(bytes))
+}
+
+/// A text whose lines end in CR alone (classic Mac OS exports) with LF line ends instead, so
+/// that it is read line by line rather than as one line; other texts as they are (CR LF is
+/// read as a line end everywhere).
+pub fn unix_line_ends(mut bytes: Vec<u8>) -> Vec<u8> {
+    if bytes.contains(&b'\r') && !bytes.contains(&b'\n') {
+        for b in &mut bytes {
+            if *b == b'\r' {
+                *b = b'\n';
+            }
+        }
+    }
+    bytes
 }
 
 /// [`read_input`] as UTF-8 text.

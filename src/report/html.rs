@@ -165,6 +165,7 @@ fn check_out_dir(req: &ReportRequest) -> Result<(), ReportError> {
 /// Returns its path.
 pub fn generate(req: &ReportRequest) -> Result<PathBuf, ReportError> {
     check_out_dir(req)?;
+    let date = crate::ident::report::utc_timestamp()?;
     let files = expand_measured(&req.measured)?;
     let tests = crate::rtest::inputs::expand_tests(&req.measured)?;
     let suite = crate::rtest::suite::evaluate_tests(&tests, &Default::default())?;
@@ -245,21 +246,31 @@ pub fn generate(req: &ReportRequest) -> Result<PathBuf, ReportError> {
             page.figure(f);
         }
     }
-    let header = header_html(req, &files, &suite, &idents);
+    let header = header_html(req, &files, &suite, &idents, &date);
     let html = page.finish(&title(&idents), &header);
 
     let mut inputs: Vec<&Path> = files.iter().map(PathBuf::as_path).collect();
     inputs.extend(req.identify_reports.iter().map(PathBuf::as_path));
     inputs.extend(req.moves.iter().map(PathBuf::as_path));
     let out = &req.out_dir;
-    std::fs::create_dir(out)
-        .or_else(|e| if out.is_dir() { Ok(()) } else { Err(e) })
-        .map_err(|e| ReportError::Output {
-            path: out.display().to_string(),
-            message: format!("cannot create folder: {e}"),
-        })?;
+    let created = match std::fs::create_dir(out) {
+        Ok(()) => true,
+        Err(_) if out.is_dir() => false,
+        Err(e) => {
+            return Err(ReportError::Output {
+                path: out.display().to_string(),
+                message: format!("cannot create folder: {e}"),
+            })
+        }
+    };
     let path = out.join(REPORT_FILE);
-    crate::io::write_atomic(&path, html.as_bytes(), &inputs)?;
+    if let Err(e) = crate::io::write_atomic(&path, html.as_bytes(), &inputs) {
+        // A report that could not be written (a full disk) leaves no empty folder behind.
+        if created {
+            let _ = std::fs::remove_dir(out);
+        }
+        return Err(e.into());
+    }
     Ok(path)
 }
 
@@ -305,6 +316,7 @@ fn header_html(
     files: &[PathBuf],
     suite: &Suite,
     idents: &[LoadedIdent],
+    date: &str,
 ) -> String {
     let mut rows: Vec<(&str, String)> = Vec::new();
     let machines = machines(idents);
@@ -318,11 +330,7 @@ fn header_html(
     ));
     rows.push((
         "report written",
-        format!(
-            "{} by eij {}",
-            crate::ident::report::utc_timestamp(),
-            env!("CARGO_PKG_VERSION")
-        ),
+        format!("{date} by eij {}", env!("CARGO_PKG_VERSION")),
     ));
     for id in idents {
         rows.push(("identification", id.title()));

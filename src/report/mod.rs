@@ -84,6 +84,9 @@ pub enum ReportError {
     /// Writing an output file failed.
     #[error(transparent)]
     Write(#[from] crate::io::WriteError),
+    /// SOURCE_DATE_EPOCH is set but is not a time.
+    #[error(transparent)]
+    SourceDate(#[from] crate::ident::report::SourceDateError),
 }
 
 /// What is known about where and on what a test ran, for titles and captions.

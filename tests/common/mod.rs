@@ -234,3 +234,24 @@ pub fn map_args(machine: &str, out: &str) -> Vec<String> {
     .map(String::from)
     .to_vec()
 }
+
+/// `eij identify` of the one bundled zx test for `z.guideway_normal` alone (fast, no ranking of
+/// candidate tests), writing `out` and `report`: the arguments, for tests that add their own.
+pub fn identify_args(out: &str, report: &str) -> Vec<String> {
+    [
+        "identify",
+        "--machine",
+        DEMO,
+        "--measured",
+        ZX_CSV,
+        "--param",
+        "z.guideway_normal",
+        "--no-design",
+        "--out",
+        out,
+        "--report",
+        report,
+    ]
+    .map(String::from)
+    .to_vec()
+}
