@@ -280,36 +280,11 @@ pub(crate) fn shift_invert(
     let norm = v0.norm_l2();
     v0 *= faer::Scale(1.0 / norm);
 
-    let params = PartialEigenParams {
-        min_dim: (count + 16).min(free),
-        max_dim: (2 * count + 32).min(free),
-        max_restarts: 2000,
-        ..Default::default()
+    let (z, mu) = if n <= 4 * count + 128 {
+        dense_eigen(&op, count)?
+    } else {
+        lanczos(&op, v0.as_ref(), count, free)?
     };
-    let mut mem = MemBuffer::new(partial_self_adjoint_eigen_scratch::<f64>(
-        &op,
-        count,
-        Par::Seq,
-        params,
-    ));
-    let mut z = Mat::zeros(n, count);
-    let mut mu = vec![0.0; count];
-    let info = partial_self_adjoint_eigen(
-        z.as_mut(),
-        &mut mu,
-        &op,
-        v0.col(0),
-        1e-10,
-        Par::Seq,
-        MemStack::new(&mut mem),
-        params,
-    );
-    if info.n_converged_eigen < count {
-        return Err(format!(
-            "the Lanczos eigensolver converged for {} of {count} modes",
-            info.n_converged_eigen
-        ));
-    }
     let mut pairs: Vec<(f64, usize)> = mu
         .iter()
         .enumerate()
@@ -330,6 +305,69 @@ pub(crate) fn shift_invert(
         eigenvalues: pairs.iter().map(|p| p.0).collect(),
         vectors: phi,
     })
+}
+
+/// The `count` largest eigenpairs of the operator by faer's restarted Lanczos (Krylov–Schur).
+fn lanczos(
+    op: &Operator<'_>,
+    v0: MatRef<'_, f64>,
+    count: usize,
+    free: usize,
+) -> Result<(Mat<f64>, Vec<f64>), String> {
+    let n = op.nrows();
+    let params = PartialEigenParams {
+        min_dim: (count + 16).min(free),
+        max_dim: (2 * count + 32).min(free),
+        max_restarts: 2000,
+        ..Default::default()
+    };
+    let mut mem = MemBuffer::new(partial_self_adjoint_eigen_scratch::<f64>(
+        op,
+        count,
+        Par::Seq,
+        params,
+    ));
+    let mut z = Mat::zeros(n, count);
+    let mut mu = vec![0.0; count];
+    let info = partial_self_adjoint_eigen(
+        z.as_mut(),
+        &mut mu,
+        op,
+        v0.col(0),
+        1e-10,
+        Par::Seq,
+        MemStack::new(&mut mem),
+        params,
+    );
+    if info.n_converged_eigen < count {
+        return Err(format!(
+            "the Lanczos eigensolver converged for {} of {count} modes",
+            info.n_converged_eigen
+        ));
+    }
+    Ok((z, mu))
+}
+
+/// The same for small models (faer's Lanczos needs a subspace smaller than the model): the
+/// operator applied to the identity and decomposed densely.
+fn dense_eigen(op: &Operator<'_>, count: usize) -> Result<(Mat<f64>, Vec<f64>), String> {
+    let n = op.nrows();
+    let mut c = Mat::zeros(n, n);
+    let mut none = MemBuffer::new(StackReq::EMPTY);
+    op.apply(
+        c.as_mut(),
+        Mat::<f64>::identity(n, n).as_ref(),
+        Par::Seq,
+        MemStack::new(&mut none),
+    );
+    let c = (&c + c.transpose()) * faer::Scale(0.5);
+    let evd = c
+        .self_adjoint_eigen(Side::Lower)
+        .map_err(|_| "the dense eigensolution did not converge".to_string())?;
+    // Ascending: the largest μ are the last columns.
+    let z = Mat::from_fn(n, count, |i, j| evd.U()[(i, n - 1 - j)]);
+    let mu = (0..count).map(|j| evd.S()[n - 1 - j]).collect();
+    Ok((z, mu))
 }
 
 /// The `count` lowest modes of K φ = λ M φ of a model held at the DOFs `fixed` (matrix rows;

@@ -49,3 +49,20 @@ pub fn static_solve(k: &DMatrix<f64>, f: &DVector<f64>, fixed: &[usize]) -> DVec
     }
     out
 }
+
+/// Eigenvalues λ of K x = λ M x for a positive definite K, ascending, from the largest
+/// eigenvalues 1/λ of L⁻¹ M L⁻ᵀ (K = LLᵀ): the low modes come out to round-off of themselves
+/// rather than of the highest mode (which bounds [`generalized_eigenvalues`]).
+pub fn held_eigenvalues(k: &DMatrix<f64>, m: &DMatrix<f64>) -> Vec<f64> {
+    let l = k.clone().cholesky().expect("K positive definite").l();
+    let li = l.try_inverse().unwrap();
+    let a = &li * m * li.transpose();
+    let a = 0.5 * (&a + a.transpose());
+    let mut e: Vec<f64> = a
+        .symmetric_eigenvalues()
+        .iter()
+        .map(|mu| 1.0 / mu)
+        .collect();
+    e.sort_by(|x, y| x.total_cmp(y));
+    e
+}
