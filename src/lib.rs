@@ -61,6 +61,7 @@
 pub mod axes;
 pub mod compensation;
 pub mod control;
+pub mod fe;
 pub mod ident;
 pub mod io;
 pub mod machine;

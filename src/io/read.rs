@@ -100,20 +100,8 @@ pub fn record_input(path: &Path) {
 /// files, up to the limit; a missing path and a folder are told apart from other failures.
 /// Lines ending in CR alone come back ending in LF ([`unix_line_ends`]).
 pub fn read_input(path: &Path, max_bytes: u64) -> Result<Vec<u8>, ReadError> {
-    let meta = std::fs::metadata(path).map_err(|e| match e.kind() {
-        std::io::ErrorKind::NotFound => ReadError::NotFound,
-        _ => ReadError::Io(e.to_string()),
-    })?;
-    if meta.is_dir() {
-        return Err(ReadError::IsAFolder);
-    }
-    if meta.is_file() && meta.len() > max_bytes {
-        return Err(ReadError::TooLarge { limit: max_bytes });
-    }
-    let file = std::fs::File::open(path).map_err(|e| ReadError::Io(e.to_string()))?;
-    record_input(path);
     let mut bytes = Vec::new();
-    file.take(max_bytes + 1)
+    open_input(path, max_bytes)?
         .read_to_end(&mut bytes)
         .map_err(|e| ReadError::Io(e.to_string()))?;
     if bytes.len() as u64 > max_bytes {
@@ -144,4 +132,24 @@ pub fn read_input_text(path: &Path, max_bytes: u64) -> Result<String, ReadError>
             e.utf8_error().valid_up_to()
         ))
     })
+}
+
+/// Opens an input file to be read as a stream of at most `max_bytes` bytes (large FE matrices
+/// are parsed line by line rather than held whole): the same checks and recording as
+/// [`read_input`]; the reader stops after `max_bytes + 1` bytes, so a caller that reads more
+/// than `max_bytes` knows the input is too large.
+pub fn open_input(path: &Path, max_bytes: u64) -> Result<std::io::Take<std::fs::File>, ReadError> {
+    let meta = std::fs::metadata(path).map_err(|e| match e.kind() {
+        std::io::ErrorKind::NotFound => ReadError::NotFound,
+        _ => ReadError::Io(e.to_string()),
+    })?;
+    if meta.is_dir() {
+        return Err(ReadError::IsAFolder);
+    }
+    if meta.is_file() && meta.len() > max_bytes {
+        return Err(ReadError::TooLarge { limit: max_bytes });
+    }
+    let file = std::fs::File::open(path).map_err(|e| ReadError::Io(e.to_string()))?;
+    record_input(path);
+    Ok(file.take(max_bytes + 1))
 }

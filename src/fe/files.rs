@@ -1,0 +1,172 @@
+//! An FE model from the files an FE program exported: Matrix Market M and K, the DOF map
+//! (`node,dof`, one line per matrix row in row order) and the nodes (`node,x_m,y_m,z_m`).
+
+use super::{mtx, DofKind, FeError, FeModel, Node};
+use crate::io::read::read_input;
+use std::path::Path;
+
+/// Most bytes of a DOF map or node file.
+const MAX_TABLE_BYTES: u64 = 256 << 20;
+
+impl FeModel {
+    /// Reads an exported FE model and checks it: sizes, the DOF map against the nodes, mass
+    /// properties (rigid-body mass > 0) and that the stiffness leaves the six rigid-body motions
+    /// free. Every error names the file, the line where there is one, and what is wrong.
+    pub fn from_files(
+        mass: &Path,
+        stiffness: &Path,
+        dofs: &Path,
+        nodes: &Path,
+    ) -> Result<FeModel, FeError> {
+        let name = |p: &Path| p.display().to_string();
+        let (m_name, k_name) = (name(mass), name(stiffness));
+        let m = mtx::read_symmetric(mass, &m_name)?;
+        let k = mtx::read_symmetric(stiffness, &k_name)?;
+        if m.nrows() != k.nrows() {
+            return Err(FeError::file(
+                &m_name,
+                format!(
+                    "the mass matrix is {0}×{0}, the stiffness matrix {k_name} {1}×{1}",
+                    m.nrows(),
+                    k.nrows()
+                ),
+            ));
+        }
+        for c in 0..m.ncols() {
+            for (r, v) in m.row_idx_of_col(c).zip(m.val_of_col(c)) {
+                if r == c && *v < 0.0 {
+                    return Err(FeError::file(
+                        &m_name,
+                        format!("diagonal entry ({0}, {0}) = {v} is negative: a mass matrix is positive semi-definite", r + 1),
+                    ));
+                }
+            }
+        }
+        let node_list = read_nodes(nodes)?;
+        let map = read_dofs(dofs, &node_list, k.nrows())?;
+        let model = FeModel::new(&k_name, m, k, node_list, &map)?;
+        model.mass_properties().map_err(|e| rename(e, &m_name))?;
+        model.check_free()?;
+        Ok(model)
+    }
+}
+
+fn rename(e: FeError, file: &str) -> FeError {
+    match e {
+        FeError::File { message, .. } => FeError::file(file, message),
+        other => other,
+    }
+}
+
+type Table = csv::Reader<std::io::Cursor<Vec<u8>>>;
+
+fn reader(path: &Path, header: &[&str]) -> Result<(String, Table), FeError> {
+    let file = path.display().to_string();
+    let bytes =
+        read_input(path, MAX_TABLE_BYTES).map_err(|e| FeError::file(&file, e.to_string()))?;
+    let mut rdr = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .comment(Some(b'#'))
+        .from_reader(std::io::Cursor::new(bytes));
+    let got: Vec<String> = rdr
+        .headers()
+        .map_err(|e| FeError::line(&file, 1, format!("not a CSV header: {e}")))?
+        .iter()
+        .map(|h| h.to_ascii_lowercase())
+        .collect();
+    if got.len() != header.len() || got.iter().zip(header).any(|(g, h)| g != h) {
+        return Err(FeError::line(
+            &file,
+            1,
+            format!(
+                "the header must be `{}`, found `{}`",
+                header.join(","),
+                got.join(",")
+            ),
+        ));
+    }
+    Ok((file, rdr))
+}
+
+fn records(
+    file: &str,
+    rdr: &mut Table,
+    mut each: impl FnMut(usize, &csv::StringRecord) -> Result<(), String>,
+) -> Result<(), FeError> {
+    for rec in rdr.records() {
+        let rec = rec.map_err(|e| {
+            let line = e.position().map(|p| p.line() as usize).unwrap_or(0);
+            FeError::line(file, line, format!("not a CSV row: {e}"))
+        })?;
+        let line = rec.position().map(|p| p.line() as usize).unwrap_or(0);
+        each(line, &rec).map_err(|m| FeError::line(file, line, m))?;
+    }
+    Ok(())
+}
+
+fn node_id(s: &str) -> Result<u64, String> {
+    s.parse()
+        .map_err(|_| format!("node `{s}` is not a whole number ≥ 0"))
+}
+
+fn read_nodes(path: &Path) -> Result<Vec<Node>, FeError> {
+    let (file, mut rdr) = reader(path, &["node", "x_m", "y_m", "z_m"])?;
+    let mut nodes = Vec::new();
+    let mut seen = std::collections::HashMap::new();
+    records(&file, &mut rdr, |line, rec| {
+        let id = node_id(&rec[0])?;
+        let mut x = [0.0; 3];
+        for (k, v) in x.iter_mut().enumerate() {
+            *v = rec[k + 1]
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| format!("coordinate `{}` is not a finite number", &rec[k + 1]))?;
+        }
+        if let Some(first) = seen.insert(id, line) {
+            return Err(format!("node {id} given twice (first on line {first})"));
+        }
+        nodes.push(Node {
+            id,
+            position: x.into(),
+        });
+        Ok(())
+    })?;
+    if nodes.is_empty() {
+        return Err(FeError::file(&file, "no nodes"));
+    }
+    Ok(nodes)
+}
+
+fn read_dofs(path: &Path, nodes: &[Node], n: usize) -> Result<Vec<(u64, DofKind)>, FeError> {
+    let (file, mut rdr) = reader(path, &["node", "dof"])?;
+    let known: std::collections::HashSet<u64> = nodes.iter().map(|p| p.id).collect();
+    let mut seen = std::collections::HashMap::new();
+    let mut map = Vec::with_capacity(n);
+    records(&file, &mut rdr, |line, rec| {
+        let id = node_id(&rec[0])?;
+        if !known.contains(&id) {
+            return Err(format!("node {id} is not in the node file"));
+        }
+        let kind = DofKind::parse(&rec[1])
+            .ok_or_else(|| format!("dof `{}` is none of ux uy uz rx ry rz", &rec[1]))?;
+        if let Some(first) = seen.insert((id, kind), line) {
+            return Err(format!(
+                "node {id} {} given twice (first on line {first})",
+                kind.name()
+            ));
+        }
+        map.push((id, kind));
+        Ok(())
+    })?;
+    if map.len() != n {
+        return Err(FeError::file(
+            &file,
+            format!(
+                "{} DOF rows, but the matrices are {n}×{n} (one row per matrix row, in row order)",
+                map.len()
+            ),
+        ));
+    }
+    Ok(map)
+}
