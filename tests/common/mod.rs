@@ -3,6 +3,7 @@
 //! series with known EIJ ([`synth`]). Every test file uses it with `mod common;`.
 #![allow(dead_code)]
 
+pub mod circle_terms;
 pub mod imperfect;
 pub mod mutation;
 pub mod random_machine;
