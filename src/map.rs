@@ -189,7 +189,7 @@ pub fn eij_map_with_progress(
             message: format!("{points} grid points, at most {MAX_POINTS}"),
         });
     }
-    let mut positions = vec![machine.reference_pose()];
+    let mut positions = vec![machine.reference_pose().to_vec()];
     for (g, &i) in grids.iter().zip(&index) {
         positions = positions
             .into_iter()

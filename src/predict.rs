@@ -27,9 +27,8 @@
 //! ```
 
 use crate::axes::{Direction, Eij, Plane};
-use crate::control::{ClosedLoop, ControlError, FrequencyForm, NearbyCertificate};
-use crate::machine::Machine;
-use crate::mbs::MbsError;
+use crate::control::{ClosedLoop, ControlError, FrequencyForm, PoseChecks};
+use crate::machine::{Machine, Pose, PoseError};
 use crate::rtest::{self, EvalOptions, RtestError};
 use crate::sim::setpoint::Circle;
 use crate::sim::{harmonic, output, simulate_discrete, Discrete, SimError};
@@ -177,16 +176,16 @@ pub enum PredictError {
         /// The axis names, comma separated.
         names: String,
     },
-    /// A circle centre the model cannot be assembled at (e.g. outside a stroke).
+    /// A circle centre that is no pose of the machine (outside a stroke).
     #[error("{test}: test position")]
     Position {
         /// Index of the test in the slice given.
         index: usize,
         /// The test's label.
         test: String,
-        /// Why the model cannot be assembled there.
+        /// Why it is no pose.
         #[source]
-        source: MbsError,
+        source: PoseError,
     },
     /// Simulating a test on one of the machines failed.
     #[error("simulating {test}")]
@@ -219,19 +218,19 @@ impl PredictError {
 pub struct Prediction {
     tests: Vec<CircleTest>,
     settings: SimSettings,
-    /// Distinct circle-centre positions of the tests, m.
-    poses: Vec<Vec<f64>>,
+    /// Distinct circle-centre positions of the tests.
+    poses: Vec<Pose>,
     /// Index into `poses` per test.
     test_pose: Vec<usize>,
-    /// Per circle centre, the stability certificate of the latest closed loop checked in full
-    /// there (the loops of a Jacobian are checked against it).
-    certificates: Arc<Vec<NearbyCertificate>>,
+    /// Per circle centre, what the closed loops there share: the support checked once, the
+    /// stability certificate of the latest loop checked in full (see [`PoseChecks`]).
+    checks: Arc<Vec<PoseChecks>>,
 }
 
 impl Prediction {
-    /// Resolves and checks the circle centres of `tests` on `machine` (every machine later
-    /// simulated must have the same axes and strokes, e.g. the same machine with other
-    /// stiffness factors).
+    /// Resolves the circle centres of `tests` on `machine` and checks each distinct one once
+    /// into a [`Pose`] (every machine later simulated must have the same axes and strokes, e.g.
+    /// the same machine with other stiffness factors).
     pub fn new(
         machine: &Machine,
         tests: Vec<CircleTest>,
@@ -240,49 +239,47 @@ impl Prediction {
         let default = settings
             .position_m
             .clone()
-            .unwrap_or_else(|| machine.reference_pose());
-        let mut poses: Vec<Vec<f64>> = Vec::new();
+            .unwrap_or_else(|| machine.reference_pose().to_vec());
+        let mut poses: Vec<Pose> = Vec::new();
         let mut test_pose = Vec::with_capacity(tests.len());
         for (index, t) in tests.iter().enumerate() {
             let pose = t.position_m.as_ref().unwrap_or(&default);
-            if pose.len() != machine.axes().len() {
-                return Err(PredictError::PositionLength {
-                    index,
-                    test: t.label(),
-                    given: pose.len(),
-                    machine: machine.name().to_string(),
-                    axes: machine.axes().len(),
-                    names: machine
-                        .axes()
-                        .iter()
-                        .map(|a| a.axis.name())
-                        .collect::<Vec<_>>()
-                        .join(", "),
-                });
-            }
-            let i = match poses.iter().position(|p| p == pose) {
+            let i = match poses.iter().position(|p| **p == **pose) {
                 Some(i) => i,
                 None => {
-                    crate::mbs::Model::assemble(machine, pose).map_err(|source| {
-                        PredictError::Position {
+                    let pose = Pose::new(machine, pose).map_err(|source| match source {
+                        PoseError::Length { got, expected, .. } => PredictError::PositionLength {
+                            index,
+                            test: t.label(),
+                            given: got,
+                            machine: machine.name().to_string(),
+                            axes: expected,
+                            names: machine
+                                .axes()
+                                .iter()
+                                .map(|a| a.axis.name())
+                                .collect::<Vec<_>>()
+                                .join(", "),
+                        },
+                        source => PredictError::Position {
                             index,
                             test: t.label(),
                             source,
-                        }
+                        },
                     })?;
-                    poses.push(pose.clone());
+                    poses.push(pose);
                     poses.len() - 1
                 }
             };
             test_pose.push(i);
         }
-        let certificates = Arc::new(poses.iter().map(|_| NearbyCertificate::default()).collect());
+        let checks = Arc::new(poses.iter().map(|_| PoseChecks::default()).collect());
         Ok(Prediction {
             tests,
             settings,
             poses,
             test_pose,
-            certificates,
+            checks,
         })
     }
 
@@ -320,13 +317,13 @@ impl Prediction {
             .into_par_iter()
             .map(|k| {
                 let (m, p) = (&machines[k / np], k % np);
-                let cl = ClosedLoop::new_near(m, &self.poses[p], &self.certificates[p]).map_err(
-                    |e| PredictError::Simulation {
+                let cl = ClosedLoop::new_near(m, &self.poses[p], &self.checks[p]).map_err(|e| {
+                    PredictError::Simulation {
                         test: "closed loop".into(),
                         machine: k / np,
                         source: e.into(),
-                    },
-                )?;
+                    }
+                })?;
                 let prepared = match solver {
                     SolverKind::Time => {
                         Prepared::Time(Discrete::new(&cl, 1.0 / self.settings.rate_hz))

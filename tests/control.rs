@@ -2,7 +2,7 @@
 
 use eij::axes::{Axis, Direction, Plane};
 use eij::control::{ClosedLoop, ControlError};
-use eij::machine::Machine;
+use eij::machine::{Machine, Pose};
 use eij::sim::setpoint::{Circle, SetPoint};
 use eij::sim::simulate;
 use nalgebra::{Complex, DMatrix, DVector};
@@ -79,7 +79,7 @@ impl SetPoint for Sine {
 #[test]
 fn following_error_at_8_hz_matches_the_hand_derived_transfer_function() {
     let machine = load("reference/single-axis.toml");
-    let cl = ClosedLoop::new(&machine, &[0.0]).unwrap();
+    let cl = ClosedLoop::new(&machine, &Pose::new(&machine, &[0.0]).unwrap()).unwrap();
     let omega = TAU * 8.0;
     let want = hand_following_error(omega);
 
@@ -226,7 +226,7 @@ fn unstable_gains_are_refused_naming_the_axis() {
         .unwrap()
         .replace("kp_nm_s_per_rad = 2.0", "kp_nm_s_per_rad = 2000.0");
     let machine = Machine::from_toml_str(&text, "hot-gains.toml").unwrap();
-    match ClosedLoop::new(&machine, &[0.0]) {
+    match ClosedLoop::new(&machine, &Pose::new(&machine, &[0.0]).unwrap()) {
         Err(e @ ControlError::Unstable { axis: Axis::X, .. }) => {
             let msg = e.to_string();
             assert!(
@@ -297,7 +297,7 @@ fn spectral_abscissa(a: &DMatrix<f64>) -> f64 {
 #[test]
 fn stability_certificate_proves_nearby_loops_and_never_an_unstable_one() {
     use eij::control::stability::Certificate;
-    use eij::control::NearbyCertificate;
+    use eij::control::PoseChecks;
     use eij::machine::Reduction;
     use eij::mbs::Model;
     let demo = load("demo-vmc.toml");
@@ -321,7 +321,7 @@ fn stability_certificate_proves_nearby_loops_and_never_an_unstable_one() {
         "stable, but far from the certificate's loop"
     );
     assert!(!cert.certifies(&far));
-    let near = NearbyCertificate::default();
+    let near = PoseChecks::default();
     assert!(ClosedLoop::new_near(&with_factor(0.3), &pose, &near).is_ok());
 
     // The single-axis drive's proportional gain up to its stability limit (bisection on the
@@ -332,7 +332,8 @@ fn stability_certificate_proves_nearby_loops_and_never_an_unstable_one() {
         let t = text.replace("kp_nm_s_per_rad = 2.0", &format!("kp_nm_s_per_rad = {kp}"));
         Machine::from_toml_str(&t, "kp.toml").unwrap()
     };
-    let stable = |kp: f64| ClosedLoop::new(&with_kp(kp), &[0.0]).is_ok();
+    let at_0 = |m: &Machine| Pose::new(m, &[0.0]).unwrap();
+    let stable = |kp: f64| ClosedLoop::new(&with_kp(kp), &at_0(&with_kp(kp))).is_ok();
     let (mut lo, mut hi) = (2.0, 2000.0);
     assert!(stable(lo) && !stable(hi));
     for _ in 0..60 {
@@ -344,7 +345,11 @@ fn stability_certificate_proves_nearby_loops_and_never_an_unstable_one() {
         }
     }
     let a_of = |kp: f64| {
-        ClosedLoop::from_model(&with_kp(kp), Model::assemble(&with_kp(kp), &[0.0]).unwrap()).a
+        ClosedLoop::from_model(
+            &with_kp(kp),
+            Model::assemble(&with_kp(kp), &at_0(&with_kp(kp))).unwrap(),
+        )
+        .a
     };
     for inside in [lo, lo * (1.0 - 1e-6), lo * (1.0 - 1e-3)] {
         let Some(cert) = Certificate::new(&a_of(inside)) else {
@@ -359,16 +364,48 @@ fn stability_certificate_proves_nearby_loops_and_never_an_unstable_one() {
         }
     }
     for kp in [lo, hi, 2000.0, 2.0] {
-        let near = NearbyCertificate::default();
+        let near = PoseChecks::default();
         assert!(
-            !near.renew(&a_of(lo * 0.9)),
+            !near.stability.renew(&a_of(lo * 0.9)),
             "the first visit makes no certificate"
         );
-        assert!(near.renew(&a_of(lo * (1.0 - 1e-3))));
+        assert!(near.stability.renew(&a_of(lo * (1.0 - 1e-3))));
         assert_eq!(
-            ClosedLoop::new_near(&with_kp(kp), &[0.0], &near).is_ok(),
+            ClosedLoop::new_near(&with_kp(kp), &at_0(&with_kp(kp)), &near).is_ok(),
             stable(kp),
             "kp {kp}"
         );
+    }
+}
+
+/// `ClosedLoop::new_near` checks the support once per pose, with the first loop there: the
+/// rigid-body modes are null(Σ fᵢKᵢ) = ∩ null(Kᵢ) for factors fᵢ > 0, so other factors keep a
+/// supported structure supported; an unsupported one is refused by every loop, not only the
+/// first, and the loops after the first are the loops `ClosedLoop::new` builds.
+#[test]
+fn support_is_checked_once_per_pose_and_never_waved_through() {
+    use eij::control::PoseChecks;
+    use eij::machine::catalogue::Catalogue;
+    use eij::machine::Reduction;
+    use eij::mbs::MbsError;
+    let demo = load("demo-vmc.toml");
+    let mut raw = demo.to_raw();
+    raw.axes[0].guideway.rails.truncate(1);
+    let one_rail = Machine::from_raw(raw, &Catalogue::bundled().unwrap(), "one-rail.toml").unwrap();
+    let pose = demo.reference_pose();
+    let checks = PoseChecks::default();
+    for visit in 0..2 {
+        match ClosedLoop::new_near(&one_rail, &pose, &checks) {
+            Err(ControlError::Mbs(MbsError::Unsupported { count: 1, .. })) => {}
+            other => panic!("visit {visit}: expected Unsupported, got {other:?}"),
+        }
+    }
+    let checks = PoseChecks::default();
+    for f in [1.0, 0.999, 0.4] {
+        let mut m = demo.clone();
+        m.set_reduction(1, Reduction::GuidewayLateral, f).unwrap();
+        let near = ClosedLoop::new_near(&m, &pose, &checks).unwrap();
+        let full = ClosedLoop::new(&m, &pose).unwrap();
+        assert_eq!(near.a, full.a, "factor {f}");
     }
 }

@@ -10,7 +10,7 @@
 use eij::axes::{Axis, Direction, Eij, Plane};
 use eij::ident::Parameter;
 use eij::machine::catalogue::Catalogue;
-use eij::machine::{ElasticBody, ElasticModel, Machine, Site};
+use eij::machine::{ElasticBody, ElasticModel, Machine, Pose, Site};
 use eij::mbs::{modal, Model};
 use eij::predict::{simulated_eij, CircleTest, SimSettings};
 use nalgebra::{DMatrix, Vector3};
@@ -127,7 +127,7 @@ fn hand_ezz(f_hz: f64) -> f64 {
 /// accelerate rigidly by a, their inertia loads the structure with f = −M·r·a, the scales hold
 /// every axis at its set point, [K B; Sᵀ 0]·[q; τ] = [f; 0], and the deviation is tcp·q.
 fn quasi_static_ezz(machine: &Machine) -> f64 {
-    let model = Model::assemble(machine, &[0.0, 0.0, 0.0]).unwrap();
+    let model = Model::assemble(machine, &Pose::new(machine, &[0.0, 0.0, 0.0]).unwrap()).unwrap();
     let (n, na) = (model.n_dof(), machine.axes().len());
     let z = machine
         .axes()
@@ -241,7 +241,7 @@ fn coordinates_are_named_and_a_rigid_motion_of_the_whole_machine_stays_free() {
         .position(|b| b.name == "head")
         .unwrap();
     for pose in [[0.0, 0.0, 0.0], [0.2, -0.15, 0.1]] {
-        let model = Model::assemble(&machine, &pose).unwrap();
+        let model = Model::assemble(&machine, &Pose::new(&machine, &pose).unwrap()).unwrap();
         let i = model.body_dofs[head].unwrap();
         assert_eq!(model.dofs[i + 6], "head.mode1");
         assert_eq!(model.dofs[i + 7], "x.motor");
@@ -262,7 +262,11 @@ fn coordinates_are_named_and_a_rigid_motion_of_the_whole_machine_stays_free() {
     }
     // With its feet, the structure is supported (only the drives move freely).
     let with_feet = elastic_demo(150.0, 1.0);
-    let model = Model::assemble(&with_feet, &[0.1, 0.1, 0.1]).unwrap();
+    let model = Model::assemble(
+        &with_feet,
+        &Pose::new(&with_feet, &[0.1, 0.1, 0.1]).unwrap(),
+    )
+    .unwrap();
     modal::check_support(&model, &with_feet).unwrap();
 }
 

@@ -1,7 +1,7 @@
 //! Multi-body assembly and modal analysis against hand calculations and physical identities.
 
 use eij::machine::catalogue::Catalogue;
-use eij::machine::Machine;
+use eij::machine::{Machine, Pose};
 use eij::mbs::{modal, MbsError, Model};
 
 mod common;
@@ -10,7 +10,7 @@ use common::machine as load;
 use common::whole_machine_motion;
 
 fn frequencies(machine: &Machine, pose: &[f64]) -> Vec<f64> {
-    let model = Model::assemble(machine, pose).unwrap();
+    let model = Model::assemble(machine, &Pose::new(machine, pose).unwrap()).unwrap();
     modal::modes(&model)
         .unwrap()
         .iter()
@@ -130,7 +130,7 @@ fn screw_stiffness_follows_the_nut_position() {
     // The axial mode frequency moves with the nut-to-bearing distance l₁ (E·A/l₁).
     let machine = load("reference/single-axis.toml");
     for s in [-0.2, 0.1, 0.2] {
-        let model = Model::assemble(&machine, &[s]).unwrap();
+        let model = Model::assemble(&machine, &Pose::new(&machine, &[s]).unwrap()).unwrap();
         let axial = modal::modes(&model)
             .unwrap()
             .into_iter()
@@ -155,7 +155,7 @@ fn screw_stiffness_follows_the_nut_position() {
 fn matrices_are_symmetric_and_stiffness_is_positive_semidefinite() {
     let machine = load("demo-vmc.toml");
     for pose in [[0.0, 0.0, 0.0], [0.3, -0.25, 0.3], [-0.3, 0.25, -0.1]] {
-        let m = Model::assemble(&machine, &pose).unwrap();
+        let m = Model::assemble(&machine, &Pose::new(&machine, &pose).unwrap()).unwrap();
         for mat in [&m.mass, &m.damping, &m.stiffness] {
             let asym = (mat - mat.transpose()).abs().max();
             assert!(asym <= 1e-12 * mat.abs().max(), "asymmetry {asym}");
@@ -241,7 +241,8 @@ fn pitch_frequency_changes_towards_the_end_of_the_stroke() {
     // must shift markedly.
     let machine = load("demo-vmc.toml");
     let pitch = |x: f64| -> f64 {
-        let model = Model::assemble(&machine, &[x, 0.0, 0.0]).unwrap();
+        let model =
+            Model::assemble(&machine, &Pose::new(&machine, &[x, 0.0, 0.0]).unwrap()).unwrap();
         modal::modes(&model)
             .unwrap()
             .into_iter()
@@ -273,7 +274,7 @@ fn unsupported_structure_is_reported_with_the_free_dof() {
         "one-rail.toml",
     )
     .unwrap();
-    let model = Model::assemble(&bad, &[0.0; 3]).unwrap();
+    let model = Model::assemble(&bad, &Pose::new(&bad, &[0.0; 3]).unwrap()).unwrap();
     match modal::check_support(&model, &bad) {
         Err(MbsError::Unsupported { count, dof, .. }) => {
             assert_eq!(count, 1);
@@ -286,7 +287,7 @@ fn unsupported_structure_is_reported_with_the_free_dof() {
 #[test]
 fn pose_outside_the_stroke_is_refused() {
     let machine = load("demo-vmc.toml");
-    let err = Model::assemble(&machine, &[0.0, 0.0, 0.31]).unwrap_err();
+    let err = Pose::new(&machine, &[0.0, 0.0, 0.31]).unwrap_err();
     assert!(
         err.to_string()
             .contains("axis z position 0.31 m is outside the stroke"),
@@ -301,7 +302,7 @@ fn screw_force_on_the_nut_comes_with_the_thread_torque() {
     // −F·h/(2π) about x on the slide (its reaction is on the ground). The nut lies on the line
     // through the COG, so the slide sees no other moment. Hand numbers from the machine file.
     let machine = load("reference/single-axis.toml");
-    let model = Model::assemble(&machine, &[0.0]).unwrap();
+    let model = Model::assemble(&machine, &Pose::new(&machine, &[0.0]).unwrap()).unwrap();
     let h = 0.02 / std::f64::consts::TAU;
     let k_shaft = 2.1e11 * std::f64::consts::PI * 0.03 * 0.03 / 4.0 / 0.5;
     let k_ax = 1.0 / (1.0 / k_shaft + 2.0 / 1e9);
@@ -334,8 +335,9 @@ fn a_rigid_motion_of_the_whole_machine_is_neither_deviation_nor_scale_reading() 
         [-0.3, 0.25, -0.1],
         [0.3, 0.25, 0.3],
     ] {
-        let model = Model::assemble(&machine, &pose).unwrap();
-        let floating = Model::assemble(&on_no_feet, &pose).unwrap();
+        let model = Model::assemble(&machine, &Pose::new(&machine, &pose).unwrap()).unwrap();
+        let floating =
+            Model::assemble(&on_no_feet, &Pose::new(&on_no_feet, &pose).unwrap()).unwrap();
         for (tr, rot) in [
             ([1e-6, -2e-6, 3e-6], [0.0, 0.0, 0.0]),
             ([0.0, 0.0, 0.0], [1e-6, 0.0, 0.0]),
@@ -376,7 +378,8 @@ fn kinetic_energy_holds_the_rotor_spinning_with_its_carrier() {
     // its centre of gravity, every rotor ½ J_rotor (φ̇ + e·ω_carrier)², φ being measured
     // against the stator on the carrier (the X motor sits on the saddle, Y and Z on the bed).
     let machine = load("demo-vmc.toml");
-    let model = Model::assemble(&machine, &[0.1, -0.2, 0.05]).unwrap();
+    let model =
+        Model::assemble(&machine, &Pose::new(&machine, &[0.1, -0.2, 0.05]).unwrap()).unwrap();
     let n = model.n_dof();
     let v = nalgebra::DVector::from_fn(n, |i, _| ((i * 7 + 3) % 11) as f64 / 11.0 - 0.4);
     let mut energy = 0.0;

@@ -6,7 +6,7 @@
 mod common;
 
 use common::random_machine::{slide, toml};
-use eij::machine::Machine;
+use eij::machine::{Machine, Pose};
 use eij::mbs::Model;
 use proptest::prelude::*;
 
@@ -21,7 +21,7 @@ proptest! {
         y in -0.2..0.2f64,
     ) {
         let machine = Machine::from_toml_str(&toml(&tool, &table), "random.toml").unwrap();
-        let model = Model::assemble(&machine, &[x, y]).unwrap();
+        let model = Model::assemble(&machine, &Pose::new(&machine, &[x, y]).unwrap()).unwrap();
         let k = &model.stiffness;
         let scale = k.amax();
         prop_assert!((k - k.transpose()).amax() <= 1e-12 * scale);

@@ -4,7 +4,7 @@
 
 use eij::axes::{Direction, Eij, Plane};
 use eij::machine::catalogue::Catalogue;
-use eij::machine::Machine;
+use eij::machine::{Machine, Pose};
 use eij::mbs::Model;
 use eij::predict::{simulated_eij, CircleTest, SimSettings};
 use nalgebra::{DMatrix, DVector};
@@ -109,7 +109,7 @@ fn on_fast_circles_the_feet_act_only_through_the_machine_inertia() {
 /// whatever motor torque that takes; the deflection q solves [K B; Sᵀ 0]·[q; τ] = [f; 0].
 /// The deviation is TCP − nest − scale reading: tcp·q (the scales read zero).
 fn quasi_static_eij(machine: &Machine, pose: &[f64]) -> BTreeMap<Eij, f64> {
-    let model = Model::assemble(machine, pose).unwrap();
+    let model = Model::assemble(machine, &Pose::new(machine, pose).unwrap()).unwrap();
     let n = model.n_dof();
     let na = machine.axes().len();
     // Rigid motion of each axis per metre of axis travel.

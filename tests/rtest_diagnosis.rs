@@ -579,7 +579,11 @@ fn backlash_at_the_right_crossings() {
 /// A cw/ccw pair of xy circles (r = 2 mm, 4 m/s²) simulated on `machine` (harmonic steady
 /// state, 3 revolutions), diagnosed and separated.
 fn simulated_pair(machine: &Machine) -> Vec<CircleDiagnosis> {
-    let cl = ClosedLoop::new(machine, &[0.0, 0.0, 0.0]).unwrap();
+    let cl = ClosedLoop::new(
+        machine,
+        &eij::machine::Pose::new(machine, &[0.0, 0.0, 0.0]).unwrap(),
+    )
+    .unwrap();
     let mut pair: Vec<CircleDiagnosis> = [Direction::Ccw, Direction::Cw]
         .into_iter()
         .map(|dir| {

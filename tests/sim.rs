@@ -2,7 +2,7 @@
 
 use eij::axes::{Axis, Direction, Plane};
 use eij::control::ClosedLoop;
-use eij::machine::Machine;
+use eij::machine::{Machine, Pose};
 use eij::sim::setpoint::{Circle, JerkLimitedMove};
 use eij::sim::{output, simulate};
 
@@ -159,11 +159,12 @@ fn segments(
 ) -> Vec<eij::sim::Segment> {
     (0..n)
         .map(|j| {
-            let mut pose = machine.reference_pose();
+            let mut pose = machine.reference_pose().to_vec();
             let mut set_position_m = vec![0.0; pose.len()];
             set_position_m[0] = mv.distance_m * (j as f64 + 0.5) / n as f64;
             pose[0] += set_position_m[0];
-            let closed_loop = ClosedLoop::new(machine, &pose).unwrap();
+            let closed_loop =
+                ClosedLoop::new(machine, &Pose::new(machine, &pose).unwrap()).unwrap();
             let discrete = eij::sim::Discrete::new(&closed_loop, 1.0 / rate);
             let from_s = if j == 0 {
                 0.0

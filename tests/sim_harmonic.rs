@@ -2,6 +2,7 @@
 
 use eij::axes::{Direction, Plane};
 use eij::control::ClosedLoop;
+use eij::machine::Pose;
 use eij::predict::{simulated_eij, CircleTest, SimSettings, SolverKind};
 use eij::sim::harmonic;
 use eij::sim::setpoint::Circle;
@@ -123,7 +124,7 @@ fn closed_form_evaluation_equals_the_sampled_evaluation() {
     use eij::rtest::{evaluate_joint, EvalOptions};
     use eij::sim::output::to_series;
     let machine = demo();
-    let mut poses = vec![machine.reference_pose()];
+    let mut poses = vec![machine.reference_pose().to_vec()];
     for f in [0.15, 0.85] {
         poses.push(
             machine
@@ -137,7 +138,7 @@ fn closed_form_evaluation_equals_the_sampled_evaluation() {
     let (mut worst, mut worst_circular, mut worst_window): (f64, f64, f64) = (0.0, 0.0, 0.0);
     let mut cases = 0;
     for pose in &poses {
-        let cl = ClosedLoop::new(&machine, pose).unwrap();
+        let cl = ClosedLoop::new(&machine, &Pose::new(&machine, pose).unwrap()).unwrap();
         let form = cl.frequency_form();
         for plane in Plane::ALL {
             for direction in Direction::ALL {

@@ -31,7 +31,7 @@ pub fn run(args: ExportArgs) -> anyhow::Result<()> {
     let out = json!({
         "machine": machine.name(),
         "source": machine.source(),
-        "pose_m": pose,
+        "pose_m": &*pose,
         "units": "SI: m, rad, kg, N, s",
         "dofs": m.dofs,
         "M": rows(&m.mass),

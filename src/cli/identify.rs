@@ -10,6 +10,7 @@ use eij::ident::{
     identify, IdentResult, Method, Parameter, Problem, Settings, SolverKind, StaticTerms,
 };
 use eij::machine::Machine;
+use eij::measured::inputs::MeasuredInputs;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -177,14 +178,16 @@ struct Prepared {
     clocks: Vec<eij::measured::suite::ClockReport>,
 }
 
+/// The identification problem of a machine (read from `machine_path`) and measured inputs
+/// (expanded once by the caller, who also checks the outputs against their files).
 fn prepare(
+    machine: Machine,
     machine_path: &Path,
-    measured_paths: &[PathBuf],
+    measured_inputs: &MeasuredInputs,
     config: &IdentConfig,
     cli_params: &[String],
     design: bool,
 ) -> anyhow::Result<Prepared> {
-    let machine = Machine::from_file(machine_path)?;
     let mut settings = Settings::default();
     settings.design = design;
     let mut mopts = MeasuredOptions::default();
@@ -206,12 +209,13 @@ fn prepare(
         tests,
         warnings,
         clocks,
-    } = measured::load_measured(measured_paths, &mopts)?;
+    } = measured::load_measured(measured_inputs, &mopts)?;
     let problem =
         Problem::new(machine, params, tests, settings).map_err(super::advice::identify)?;
     let provenance = Provenance::now(
         machine_path.display().to_string(),
-        measured::expand(measured_paths)?
+        measured_inputs
+            .data_files()
             .iter()
             .map(|p| p.display().to_string())
             .collect(),
@@ -321,8 +325,10 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
     }
     // Inputs of the run (never overwritten): measured and validation files, the rtest.toml of
     // their folders, the machine and the config. Outputs are checked before any work.
-    let measured_files = measured::expand(&args.measured)?;
-    let validation_files = measured::expand(&args.validate)?;
+    let measured_inputs = MeasuredInputs::expand(&args.measured)?;
+    let validation_inputs = MeasuredInputs::expand(&args.validate)?;
+    let measured_files = measured_inputs.data_files();
+    let validation_files = validation_inputs.data_files();
     if let Some(f) = validation_files.iter().find(|f| measured_files.contains(f)) {
         bail!(
             "{}: given both as measured and as validation data (hold-out tests must not be fitted)",
@@ -331,21 +337,15 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
     }
     let mut inputs: Vec<PathBuf> = measured_files;
     inputs.extend(validation_files);
-    let conditions: Vec<PathBuf> = inputs
-        .iter()
-        .filter_map(|f| {
-            f.parent()
-                .map(|d| d.join(eij::measured::conditions::CONDITIONS_FILE))
-        })
-        .filter(|c| c.is_file())
-        .collect();
-    inputs.extend(conditions);
+    inputs.extend(measured_inputs.conditions_files());
+    inputs.extend(validation_inputs.conditions_files());
     inputs.push(args.machine.clone());
     if let Some(c) = &args.config {
         inputs.push(c.clone());
     }
     let input_refs: Vec<&Path> = inputs.iter().map(|p| p.as_path()).collect();
-    let stem = file_stem(&Machine::from_file(&args.machine)?.name());
+    let machine = Machine::from_file(&args.machine)?;
+    let stem = file_stem(machine.name());
     let default_out = Path::new(DEFAULT_DIR).join(format!("{stem}-identified.toml"));
     let default_report = Path::new(DEFAULT_DIR).join(format!("{stem}-identify-report.json"));
     let out = args.out.clone().unwrap_or(default_out);
@@ -366,11 +366,18 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
     .collect();
     eij::io::check_outputs(&outputs, &input_refs)?;
 
-    let prep = prepare(&args.machine, &args.measured, &config, &args.params, true)?;
+    let prep = prepare(
+        machine,
+        &args.machine,
+        &measured_inputs,
+        &config,
+        &args.params,
+        true,
+    )?;
     let validation_tests = if args.validate.is_empty() {
         None
     } else {
-        Some(measured::load(&args.validate, &prep.measured_options)?)
+        Some(measured::load_measured(&validation_inputs, &prep.measured_options)?.tests)
     };
     let (result, seconds) = run_identification(&prep, super::console::quiet())?;
     let validation = match validation_tests {
@@ -488,7 +495,16 @@ pub fn verify(args: VerifyArgs) -> anyhow::Result<()> {
 pub fn verify_one(file: &Path) -> anyhow::Result<Vec<String>> {
     let k = KnownGood::from_file(file)?;
     // The ranking of candidate tests does not change the factors: not needed here.
-    let prep = prepare(&k.machine, &k.measured, &k.settings, &[], false)?;
+    let machine = Machine::from_file(&k.machine)?;
+    let measured_inputs = MeasuredInputs::expand(&k.measured)?;
+    let prep = prepare(
+        machine,
+        &k.machine,
+        &measured_inputs,
+        &k.settings,
+        &[],
+        false,
+    )?;
     let (result, _) = run_identification(&prep, true)?;
     let mut lines = Vec::new();
     if let Some(refusal) = &result.refusal {

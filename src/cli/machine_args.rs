@@ -1,6 +1,6 @@
 //! Options shared by the commands that load a machine.
 
-use eij::machine::Machine;
+use eij::machine::{Machine, Pose, PoseError};
 use std::path::PathBuf;
 
 /// `--machine FILE.toml [--position-mm X,Y,Z]`.
@@ -21,37 +21,38 @@ pub struct MachineArgs {
 }
 
 impl MachineArgs {
-    /// Loads the machine and the pose (m).
-    pub fn load(&self) -> anyhow::Result<(Machine, Vec<f64>)> {
+    /// Loads the machine and the pose, checked once here ([`Pose::new`]).
+    pub fn load(&self) -> anyhow::Result<(Machine, Pose)> {
         let machine = Machine::from_file(&self.machine)?;
         let pose = match &self.position_mm {
             None => machine.reference_pose(),
             Some(p) => {
-                if p.len() != machine.axes().len() {
-                    anyhow::bail!(
-                        "--position-mm: {} values given, machine {} has {} axes ({})",
-                        p.len(),
+                let m: Vec<f64> = p.iter().map(|v| v * 1e-3).collect();
+                Pose::new(&machine, &m).map_err(|e| match e {
+                    PoseError::Length { got, expected, .. } => anyhow::anyhow!(
+                        "--position-mm: {got} values given, machine {} has {expected} axes ({})",
                         self.machine.display(),
-                        machine.axes().len(),
                         machine
                             .axes()
                             .iter()
                             .map(|a| a.axis.name())
                             .collect::<Vec<_>>()
                             .join(", ")
-                    );
-                }
-                for (a, v) in machine.axes().iter().zip(p) {
-                    let [lo, hi] = a.stroke_m.map(|s| s * 1e3);
-                    if !(v.is_finite() && lo <= *v && *v <= hi) {
-                        anyhow::bail!(
-                            "--position-mm: {} = {v} mm is outside the stroke [{lo}, {hi}] mm of {}",
-                            a.axis,
-                            self.machine.display()
-                        );
-                    }
-                }
-                p.iter().map(|v| v * 1e-3).collect()
+                    ),
+                    PoseError::OutOfStroke {
+                        index,
+                        axis,
+                        min_m,
+                        max_m,
+                        ..
+                    } => anyhow::anyhow!(
+                        "--position-mm: {axis} = {} mm is outside the stroke [{}, {}] mm of {}",
+                        p[index],
+                        min_m * 1e3,
+                        max_m * 1e3,
+                        self.machine.display()
+                    ),
+                })?
             }
         };
         Ok((machine, pose))

@@ -1,7 +1,7 @@
 //! `eij modal --machine FILE.toml [--json]`
 
 use super::machine_args::MachineArgs;
-use eij::mbs::{modal, Model};
+use eij::mbs::modal;
 use serde_json::json;
 
 /// Arguments of `eij modal`.
@@ -19,9 +19,7 @@ pub fn run(args: ModalArgs) -> anyhow::Result<()> {
     let (machine, pose) = args.machine.load()?;
     // The same checks as every other command (support, stable closed loop), so that no machine
     // that `export` or `simulate` refuses gets frequencies here.
-    eij::control::ClosedLoop::new(&machine, &pose)?;
-    let model = Model::assemble(&machine, &pose)?;
-    modal::check_support(&model, &machine)?;
+    let model = eij::control::ClosedLoop::new(&machine, &pose)?.model;
     let modes = modal::modes(&model)?;
     if let Some(m) = modes.iter().find(|m| !m.frequency_hz.is_finite()) {
         anyhow::bail!(
@@ -34,7 +32,7 @@ pub fn run(args: ModalArgs) -> anyhow::Result<()> {
     if args.json {
         let out = json!({
             "machine": machine.source(),
-            "pose_m": pose,
+            "pose_m": &*pose,
             "frequencies_hz": modes.iter().map(|m| m.frequency_hz).collect::<Vec<_>>(),
             "modes": modes.iter().map(|m| json!({
                 "frequency_hz": m.frequency_hz,

@@ -5,7 +5,7 @@ use anyhow::{bail, Context};
 use eij::axes::{Axis, Direction, Plane};
 use eij::compensation::{Compensated, CompensationTable};
 use eij::control::ClosedLoop;
-use eij::machine::Machine;
+use eij::machine::{Machine, Pose};
 use eij::report::{move_svg, CircleView, Conditions, MoveData};
 use eij::rtest::EvalOptions;
 use eij::sim::setpoint::{Circle, JerkLimitedMove, SetPoint};
@@ -196,7 +196,7 @@ fn check_samples(common: &Common, sp: &dyn SetPoint, freq_hz: Option<f64>) -> an
 impl Common {
     /// Loads the machine and its pose, the compensation table, then checks the outputs (with
     /// every file read so far: the machine's catalogues and the table count as inputs).
-    fn load(&self) -> anyhow::Result<(Machine, Vec<f64>, Option<CompensationTable>)> {
+    fn load(&self) -> anyhow::Result<(Machine, Pose, Option<CompensationTable>)> {
         let (machine, pose) = self.machine.load()?;
         let table = self.table(&machine)?;
         let mut outputs = vec![self.out.as_path()];

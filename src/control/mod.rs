@@ -18,14 +18,30 @@
 
 use crate::axes::Axis;
 use crate::machine::raw::Feedback;
-use crate::machine::Machine;
+use crate::machine::{Machine, Pose};
 use crate::mbs::{modal, MbsError, Model};
 use nalgebra::{Complex, DMatrix, DVector};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 pub mod frequency;
 pub mod stability;
 pub use frequency::FrequencyForm;
 pub use stability::NearbyCertificate;
+
+/// What the closed loops at one pose share when they differ only in stiffness factors (see
+/// [`ClosedLoop::new_near`]; shared between threads).
+///
+/// The support: the structure's rigid-body modes are the null space of K = Σ fᵢ·Kᵢ, a sum of
+/// positive semi-definite element stiffnesses Kᵢ with factors fᵢ > 0, which is ∩ null(Kᵢ)
+/// whatever the factors' values; so once one loop's structure is supported, every other's is.
+/// The stability: the certificate of the latest loop checked in full ([`NearbyCertificate`]).
+#[derive(Debug, Default)]
+pub struct PoseChecks {
+    /// Whether a loop's structure was found supported here.
+    supported: AtomicBool,
+    /// The stability certificate shared by the loops here.
+    pub stability: NearbyCertificate,
+}
 
 /// Errors building the closed loop.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -33,6 +49,9 @@ pub enum ControlError {
     /// Assembly or support check failed.
     #[error(transparent)]
     Mbs(#[from] MbsError),
+    /// Axis positions that are no pose of the machine.
+    #[error(transparent)]
+    Pose(#[from] crate::machine::PoseError),
     /// The closed loop has an eigenvalue with non-negative real part.
     #[error("{machine}: closed loop unstable at axis {axis} (eigenvalue {re:.3} ± {im:.3}i 1/s, {freq_hz:.1} Hz): {hint}")]
     Unstable {
@@ -89,27 +108,34 @@ pub struct ClosedLoop {
 }
 
 impl ClosedLoop {
-    /// Assembles the structure at `pose_m`, checks its support, closes the loops and checks
+    /// Assembles the structure at `pose`, checks its support, closes the loops and checks
     /// stability.
-    pub fn new(machine: &Machine, pose_m: &[f64]) -> Result<ClosedLoop, ControlError> {
-        let model = Model::assemble(machine, pose_m)?;
+    pub fn new(machine: &Machine, pose: &Pose) -> Result<ClosedLoop, ControlError> {
+        let model = Model::assemble(machine, pose)?;
         modal::check_support(&model, machine)?;
         let cl = ClosedLoop::from_model(machine, model);
         cl.check_stability(machine)?;
         Ok(cl)
     }
 
-    /// As [`ClosedLoop::new`], with the stability check first trying `near`'s Lyapunov
-    /// certificate (see [`stability`]): for the loops of a finite-difference Jacobian, close to
-    /// one checked in full, a tenth of the eigenvalue problem's cost, with the same verdict.
+    /// As [`ClosedLoop::new`] for one of several loops at one pose with other stiffness
+    /// factors (an identification's parameter sets), with what `checks` knows from the loops
+    /// before: the support is checked by the first loop only (see [`PoseChecks`]), and the
+    /// stability check first tries the Lyapunov certificate of a loop checked in full (see
+    /// [`stability`]): for the loops of a finite-difference Jacobian a tenth of the eigenvalue
+    /// problem's cost, with the same verdict.
     pub fn new_near(
         machine: &Machine,
-        pose_m: &[f64],
-        near: &NearbyCertificate,
+        pose: &Pose,
+        checks: &PoseChecks,
     ) -> Result<ClosedLoop, ControlError> {
-        let model = Model::assemble(machine, pose_m)?;
-        modal::check_support(&model, machine)?;
+        let model = Model::assemble(machine, pose)?;
+        if !checks.supported.load(Ordering::Relaxed) {
+            modal::check_support(&model, machine)?;
+            checks.supported.store(true, Ordering::Relaxed);
+        }
         let cl = ClosedLoop::from_model(machine, model);
+        let near = &checks.stability;
         // The loop's own certificate, when one is made, proves it stable as well (the
         // eigenvalue check then decides only where no certificate proves anything).
         if !near.certifies(&cl.a) && !near.renew(&cl.a) {

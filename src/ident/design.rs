@@ -127,7 +127,7 @@ fn grid(problem: &Problem) -> Vec<CircleTest> {
             })
             .collect();
     }
-    poses.retain(|p| crate::mbs::Model::assemble(machine, p).is_ok());
+    poses.retain(|p| crate::machine::Pose::new(machine, p).is_ok());
     let mut out = Vec::new();
     for plane in Plane::ALL {
         let (a, b) = plane.axes();

@@ -4,17 +4,12 @@
 pub use super::settings::MeasuredOptions;
 use super::{IdentError, TestCase};
 use crate::measured::conditions::Recording;
-use crate::measured::inputs::{expand_tests, TestInput};
+use crate::measured::inputs::{MeasuredInputs, TestInput};
 use crate::measured::suite::{evaluate_tests, ClockReport, SuiteOptions};
 use crate::measured::table;
 use crate::predict::CircleTest;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
-
-/// Expands folders (their `*.csv`, sub-folders included, sorted) and keeps files.
-pub fn expand(paths: &[PathBuf]) -> Result<Vec<PathBuf>, IdentError> {
-    Ok(crate::measured::inputs::expand_inputs(paths)?)
-}
 
 /// Reads every path into test cases: R-Test series (single files and two-system recordings
 /// with their `rtest.toml` conditions) are evaluated as `eij evaluate` does
@@ -22,18 +17,7 @@ pub fn expand(paths: &[PathBuf]) -> Result<Vec<PathBuf>, IdentError> {
 /// radius from `rtest.toml`, else `opts.radius_mm`; EIJ tables are grouped by plane, direction
 /// and acceleration. Folders are read with their sub-folders.
 pub fn load(paths: &[PathBuf], opts: &MeasuredOptions) -> Result<Vec<TestCase>, IdentError> {
-    Ok(load_with_warnings(paths, opts)?.0)
-}
-
-/// As [`load`], with what the evaluation says about the tests' conditions and clocks (a
-/// direction or feed at odds with the data, a clock offset not separable from cross-talk),
-/// each naming its test or clock: for the identification's warnings.
-pub fn load_with_warnings(
-    paths: &[PathBuf],
-    opts: &MeasuredOptions,
-) -> Result<(Vec<TestCase>, Vec<String>), IdentError> {
-    let m = load_measured(paths, opts)?;
-    Ok((m.tests, m.warnings))
+    Ok(load_measured(&MeasuredInputs::expand(paths)?, opts)?.tests)
 }
 
 /// What [`load_measured`] read.
@@ -49,9 +33,14 @@ pub struct Measured {
     pub clocks: Vec<ClockReport>,
 }
 
-/// As [`load`], with warnings and clock offsets.
-pub fn load_measured(paths: &[PathBuf], opts: &MeasuredOptions) -> Result<Measured, IdentError> {
-    let inputs = expand_tests(paths)?;
+/// As [`load`] on inputs already expanded, with what the evaluation says about the tests'
+/// conditions and clocks (a direction or feed at odds with the data, a clock offset not
+/// separable from cross-talk, each naming its test or clock) and the clock offsets.
+pub fn load_measured(
+    inputs: &MeasuredInputs,
+    opts: &MeasuredOptions,
+) -> Result<Measured, IdentError> {
+    let inputs = &inputs.tests;
     let (tables, series): (Vec<&TestInput>, Vec<&TestInput>) = inputs
         .iter()
         .partition(|t| matches!(&t.recording, Recording::Single(f) if table::looks_like_table(f)));
@@ -90,7 +79,7 @@ pub fn load_measured(paths: &[PathBuf], opts: &MeasuredOptions) -> Result<Measur
     );
     let mut evaluated = suite.tests.into_iter();
     let mut tests = Vec::new();
-    for input in &inputs {
+    for input in inputs {
         let position_m = input
             .position_mm
             .as_ref()

@@ -8,6 +8,7 @@
 mod attach;
 pub mod body;
 pub mod catalogue;
+mod pose;
 pub mod raw;
 pub mod stiffness;
 mod validate;
@@ -17,6 +18,7 @@ pub use attach::BodySite;
 pub use body::{Body, BodyKind, ElasticBody, ElasticModel, Site};
 use catalogue::{CarriageData, Catalogue};
 use nalgebra::Vector3;
+pub use pose::{Pose, PoseError};
 use raw::{Feedback, RawMachine, Support};
 use std::path::Path;
 
@@ -255,7 +257,9 @@ pub struct Machine {
     axes: Vec<LinearAxis>,
     joints: Vec<Joint>,
     moved_by: Vec<Option<usize>>,
-    raw: RawMachine,
+    /// The file as read, for [`Machine::to_raw`]; shared, so that the machines of an
+    /// identification's parameter sets (clones with other factors) do not copy it.
+    raw: std::sync::Arc<RawMachine>,
 }
 
 /// A stiffness reduction factor of an axis, the quantities an identification adjusts.
@@ -399,7 +403,7 @@ impl Machine {
     /// The raw description with the current reduction factors and damping written back, e.g.
     /// for exporting an identified machine.
     pub fn to_raw(&self) -> RawMachine {
-        let mut raw = self.raw.clone();
+        let mut raw = RawMachine::clone(&self.raw);
         for (ra, a) in raw.axes.iter_mut().zip(&self.axes) {
             ra.guideway.reduction_normal = a.guideway.reduction_normal;
             ra.guideway.reduction_lateral = a.guideway.reduction_lateral;
@@ -416,8 +420,8 @@ impl Machine {
     }
 
     /// Reference position of every axis (in [`Machine::axes`] order), m.
-    pub fn reference_pose(&self) -> Vec<f64> {
-        self.axes.iter().map(|a| a.reference_m).collect()
+    pub fn reference_pose(&self) -> Pose {
+        Pose::reference(self)
     }
 
     /// Total mass carried by an axis (its moving body and every body it carries), kg.

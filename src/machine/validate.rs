@@ -319,7 +319,7 @@ impl Machine {
             axes,
             joints,
             moved_by,
-            raw,
+            raw: std::sync::Arc::new(raw),
         })
     }
 }

@@ -24,38 +24,12 @@
 
 pub mod modal;
 
-use crate::machine::{Machine, Site};
+use crate::machine::{Machine, Pose, Site};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
 /// Errors of the assembly and of the support check.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MbsError {
-    /// A pose with the wrong number of axes.
-    #[error("{machine}: pose has {got} axis positions, the machine has {expected} axes")]
-    PoseLength {
-        /// Machine source.
-        machine: String,
-        /// Given.
-        got: usize,
-        /// Expected.
-        expected: usize,
-    },
-    /// An axis position outside its stroke.
-    #[error(
-        "{machine}: axis {axis} position {position_m} m is outside the stroke [{min_m}, {max_m}] m"
-    )]
-    OutOfStroke {
-        /// Machine source.
-        machine: String,
-        /// Axis name.
-        axis: String,
-        /// Position asked for.
-        position_m: f64,
-        /// Stroke minimum.
-        min_m: f64,
-        /// Stroke maximum.
-        max_m: f64,
-    },
     /// The structure has rigid-body modes beyond the one per drive: some body is not supported.
     #[error("{machine}: the guideways and joints cannot support the structure: {count} unsupported motion(s), dominated by DOF {dof} (check the carriage and joint arrangement)")]
     Unsupported {
@@ -162,27 +136,10 @@ fn screw_force(t: &DMatrix<f64>, e: &Vector3<f64>, h: f64) -> DVector<f64> {
 }
 
 impl Model {
-    /// Assembles M, D, K at axis position `pose_m` (m, machine axis order).
-    pub fn assemble(machine: &Machine, pose_m: &[f64]) -> Result<Model, MbsError> {
-        if pose_m.len() != machine.axes().len() {
-            return Err(MbsError::PoseLength {
-                machine: machine.source().to_string(),
-                got: pose_m.len(),
-                expected: machine.axes().len(),
-            });
-        }
-        for (a, &s) in machine.axes().iter().zip(pose_m) {
-            let [lo, hi] = a.stroke_m;
-            if !(s.is_finite() && lo <= s && s <= hi) {
-                return Err(MbsError::OutOfStroke {
-                    machine: machine.source().to_string(),
-                    axis: a.axis.to_string(),
-                    position_m: s,
-                    min_m: lo,
-                    max_m: hi,
-                });
-            }
-        }
+    /// Assembles M, D, K at the axis positions `pose` (checked against the machine's axes and
+    /// strokes when the pose was made).
+    pub fn assemble(machine: &Machine, pose: &Pose) -> Result<Model, MbsError> {
+        let pose_m: &[f64] = pose;
         let nb = machine.bodies().len();
         // Shift of every body at this pose.
         let shift: Vec<Vector3<f64>> = (0..nb)

@@ -325,15 +325,42 @@ fn once_each(tests: &[TestInput]) -> Result<(), MeasuredError> {
     Ok(())
 }
 
-/// The files of the measured inputs of a command (every file of every test of
-/// [`expand_tests`], in test order; both files of a two-system test): for the provenance of
-/// outputs and for refusing to write over an input.
-pub fn expand_inputs(paths: &[PathBuf]) -> Result<Vec<PathBuf>, MeasuredError> {
-    Ok(expand_tests(paths)?
-        .into_iter()
-        .flat_map(|t| match t.recording {
-            Recording::Single(f) => vec![f],
-            Recording::Split { internal, external } => vec![internal, external],
+/// The measured inputs of a command, expanded once: its circle tests (see [`expand_tests`]),
+/// from which the files it reads (for provenance and for refusing to write over an input) and
+/// the tests it evaluates both come.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct MeasuredInputs {
+    /// The tests, in path order.
+    pub tests: Vec<TestInput>,
+}
+
+impl MeasuredInputs {
+    /// Expands files and folders into tests ([`expand_tests`]); no paths, no tests.
+    pub fn expand(paths: &[PathBuf]) -> Result<MeasuredInputs, MeasuredError> {
+        Ok(MeasuredInputs {
+            tests: expand_tests(paths)?,
         })
-        .collect())
+    }
+
+    /// The data files of every test, in test order (both files of a two-system test).
+    pub fn data_files(&self) -> Vec<PathBuf> {
+        self.tests
+            .iter()
+            .flat_map(|t| match &t.recording {
+                Recording::Single(f) => vec![f.clone()],
+                Recording::Split { internal, external } => vec![internal.clone(), external.clone()],
+            })
+            .collect()
+    }
+
+    /// The `rtest.toml` files the tests' conditions come from, each once.
+    pub fn conditions_files(&self) -> Vec<PathBuf> {
+        let mut files: Vec<PathBuf> = Vec::new();
+        for f in self.tests.iter().filter_map(|t| t.conditions_file.as_ref()) {
+            if !files.contains(f) {
+                files.push(f.clone());
+            }
+        }
+        files
+    }
 }

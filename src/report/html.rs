@@ -21,6 +21,7 @@ use super::{
 };
 use crate::axes::Plane;
 use crate::ident::report::IdentReport;
+use crate::measured::inputs::MeasuredInputs;
 use crate::measured::suite::{EvaluatedTest, Suite};
 
 /// The report page's file name.
@@ -39,11 +40,6 @@ pub struct ReportRequest {
     pub extra_figures: Vec<Figure>,
     /// The report folder (created if missing; an existing file there is refused).
     pub out_dir: PathBuf,
-}
-
-/// Expands files and folders (see [`crate::measured::inputs::expand_inputs`]).
-pub fn expand_measured(paths: &[PathBuf]) -> Result<Vec<PathBuf>, ReportError> {
-    Ok(crate::measured::inputs::expand_inputs(paths)?)
 }
 
 /// The name of a test with its circle centre: `pos-a/xy_ccw_2.csv @ 150,-100,0 mm`.
@@ -118,9 +114,9 @@ fn check_out_dir(req: &ReportRequest) -> Result<(), ReportError> {
 pub fn generate(req: &ReportRequest) -> Result<PathBuf, ReportError> {
     check_out_dir(req)?;
     let date = crate::ident::report::utc_timestamp()?;
-    let files = expand_measured(&req.measured)?;
-    let tests = crate::measured::inputs::expand_tests(&req.measured)?;
-    let suite = crate::measured::suite::evaluate_tests(&tests, &Default::default())?;
+    let measured = MeasuredInputs::expand(&req.measured)?;
+    let files = measured.data_files();
+    let suite = crate::measured::suite::evaluate_tests(&measured.tests, &Default::default())?;
     let groups = circle_group::groups(&suite)?;
     let scale = circle_group::page_scale(&groups);
     let circle_figures = groups

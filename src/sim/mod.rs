@@ -282,6 +282,7 @@ pub fn move_segments(
             let mut set_position_m = vec![0.0; start_m.len()];
             set_position_m[axis_index] = mv.distance_m * (j as f64 + 0.5) / n as f64;
             pose[axis_index] += set_position_m[axis_index];
+            let pose = crate::machine::Pose::new(machine, &pose)?;
             let closed_loop = ClosedLoop::new(machine, &pose)?;
             let discrete = Discrete::new(&closed_loop, 1.0 / rate_hz);
             let from_s = if j == 0 {

@@ -74,6 +74,7 @@ pub fn grid(positions_mm: &[[f64; 3]], planes: &[Plane], accels: &[f64]) -> Vec<
 pub fn series(truth: &Machine, t: &Planned, imp: &Imperfections, seed: u64) -> CircleSeries {
     let radius_m = 2e-3;
     let pose: Vec<f64> = t.position_mm.iter().map(|v| v * 1e-3).collect();
+    let pose = eij::machine::Pose::new(truth, &pose).unwrap();
     let cl = ClosedLoop::new(truth, &pose).unwrap();
     let ph = harmonic::circle_phasors(&cl, t.plane, radius_m, t.accel_m_s2, t.direction).unwrap();
     let freq = ph.omega.abs() / std::f64::consts::TAU;
