@@ -10,6 +10,8 @@
 //! machine ─► mbs ─► control ─► sim ─► rtest ─► predict ─► ident ─► report
 //! ```
 //!
+//! * [`fe`]: elastic bodies: FE models exported from an FE program or built as Timoshenko beams,
+//!   reduced by Craig–Bampton to rigid-body plus modal coordinates (feeds `machine`).
 //! * [`machine`]: the validated machine description (bodies, axes, guideways, drives, control),
 //!   read from TOML with catalogue look-up of carriage stiffness.
 //! * [`mbs`]: assembly of the mass, damping and stiffness matrices at an axis position; modal
