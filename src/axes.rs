@@ -158,6 +158,15 @@ impl Direction {
         }
     }
 
+    /// The direction of a signed angular speed ω: ccw for ω > 0, else cw.
+    pub fn of_omega(omega_rad_s: f64) -> Direction {
+        if omega_rad_s > 0.0 {
+            Direction::Ccw
+        } else {
+            Direction::Cw
+        }
+    }
+
     /// Sign of ω: +1 for ccw, −1 for cw.
     pub fn sign(self) -> f64 {
         match self {

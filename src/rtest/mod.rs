@@ -39,6 +39,7 @@ pub mod checks;
 pub mod clock;
 pub mod clock_fit;
 pub mod conditions;
+pub mod diagnosis;
 pub mod error;
 pub mod fit;
 pub mod harmonic;
@@ -201,11 +202,7 @@ pub fn evaluate(series: &CircleSeries, opts: &EvalOptions) -> Result<CircleResul
             _ => None,
         }
     };
-    let direction = if norm.omega_rad_s > 0.0 {
-        Direction::Ccw
-    } else {
-        Direction::Cw
-    };
+    let direction = Direction::of_omega(norm.omega_rad_s);
     Ok(CircleResult {
         source: series.source().to_string(),
         plane: norm.plane,

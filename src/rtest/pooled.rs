@@ -124,13 +124,7 @@ pub fn evaluate_pooled(
 
     let directions: Vec<Direction> = norms
         .iter()
-        .map(|n| {
-            if n.omega_rad_s > 0.0 {
-                Direction::Ccw
-            } else {
-                Direction::Cw
-            }
-        })
+        .map(|n| Direction::of_omega(n.omega_rad_s))
         .collect();
     let mut warnings = Vec::new();
     let mut cw_ccw = BTreeMap::new();
