@@ -79,7 +79,11 @@ fn fixed_bed_machine() -> Machine {
         + &demo_text()[demo_text().find("# ---------------------------------------------------------------- X").unwrap()..];
     let machine = Machine::from_toml_str(&text, "fixed-bed").unwrap();
     assert!(
-        machine.bodies().iter().any(|b| b.name == "bed" && b.fixed) && machine.joints().is_empty()
+        machine
+            .bodies()
+            .iter()
+            .any(|b| b.name == "bed" && b.is_fixed())
+            && machine.joints().is_empty()
     );
     machine
 }

@@ -7,6 +7,7 @@ use eij::mbs::{modal, MbsError, Model};
 mod common;
 
 use common::machine as load;
+use common::whole_machine_motion;
 
 fn frequencies(machine: &Machine, pose: &[f64]) -> Vec<f64> {
     let model = Model::assemble(machine, pose).unwrap();
@@ -315,39 +316,6 @@ fn screw_force_on_the_nut_comes_with_the_thread_torque() {
     assert!(f[4].abs() < 1e-9 * force && f[5].abs() < 1e-9 * force);
     // On the rotor: the screw's reaction −F·h/(2π).
     assert_rel(f[model.axes[0].rotor_dof], -force * h, 1e-12);
-}
-
-/// The rigid motion of every free body together, as a small rotation `rot` about the point `o`
-/// plus a translation `tr` (rotors held relative to their carriers).
-fn whole_machine_motion(
-    machine: &Machine,
-    model: &Model,
-    pose: &[f64],
-    tr: nalgebra::Vector3<f64>,
-    rot: nalgebra::Vector3<f64>,
-    o: nalgebra::Vector3<f64>,
-) -> nalgebra::DVector<f64> {
-    let mut v = nalgebra::DVector::zeros(model.n_dof());
-    let mut i = 0;
-    for (b, body) in machine.bodies().iter().enumerate() {
-        if body.fixed {
-            continue;
-        }
-        // The body's COG at this pose: shifted by every axis that carries it.
-        let mut c = body.cog_m;
-        for (ai, a) in machine.axes().iter().enumerate() {
-            if machine.is_carried_by(b, ai) {
-                c += a.direction() * (a.side.sign() * (pose[ai] - a.reference_m));
-            }
-        }
-        let u = tr + rot.cross(&(c - o));
-        for d in 0..3 {
-            v[i + d] = u[d];
-            v[i + 3 + d] = rot[d];
-        }
-        i += 6;
-    }
-    v
 }
 
 #[test]

@@ -117,17 +117,12 @@ fn quasi_static_eij(machine: &Machine, pose: &[f64]) -> BTreeMap<Eij, f64> {
     for (j, axis) in machine.axes().iter().enumerate() {
         let sigma = axis.side.sign();
         let mut r = DVector::zeros(n);
-        let mut dof = 0;
-        for (b, body) in machine.bodies().iter().enumerate() {
-            if body.fixed {
-                continue;
-            }
-            if machine.is_carried_by(b, j) {
+        for b in 0..machine.bodies().len() {
+            if let (Some(dof), true) = (model.body_dofs[b], machine.is_carried_by(b, j)) {
                 for d in 0..3 {
                     r[dof + d] = sigma * axis.direction()[d];
                 }
             }
-            dof += 6;
         }
         r[model.axes[j].rotor_dof] = sigma / axis.drive.transmission_m_per_rad();
         let f = -(&model.mass * &r);

@@ -1,5 +1,5 @@
-//! The identified quantities: reduction factors on the catalogue data of one axis, and the
-//! compliance factors θ = 1/p the optimiser works in.
+//! The identified quantities: reduction factors on the catalogue data of one axis, or the factor
+//! on an elastic body's stiffness, and the compliance factors θ = 1/p the optimiser works in.
 
 use super::IdentError;
 use crate::axes::Axis;
@@ -16,29 +16,51 @@ pub enum ParameterKind {
     GuidewayLateral,
     /// Axial stiffness of the ball-screw drive (`<axis>.screw`).
     Screw,
+    /// The whole elastic stiffness of an elastic body (`<body>.stiffness`, as on Young's
+    /// modulus).
+    BodyStiffness,
 }
 
-/// One identified quantity: a reduction factor on the catalogue data of one axis.
+/// One identified quantity: a reduction factor on the catalogue data of one axis, or the
+/// stiffness factor of an elastic body.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Parameter {
-    /// Name, e.g. `z.guideway_normal`.
+    /// Name, e.g. `z.guideway_normal` or `column.stiffness`.
     pub name: String,
-    /// Index of the axis in [`Machine::axes`].
-    pub axis_index: usize,
     /// What it scales.
     pub kind: ParameterKind,
+    /// Index of its axis in [`Machine::axes`], or of its body in [`Machine::bodies`] for
+    /// [`ParameterKind::BodyStiffness`].
+    index: usize,
 }
 
 impl Parameter {
-    /// Parses `<axis>.<kind>` for `machine`.
+    /// Parses `<axis>.<kind>` or `<body>.stiffness` for `machine`.
     pub fn parse(name: &str, machine: &Machine) -> Result<Parameter, IdentError> {
         let bad = |m: String| IdentError::Parameter {
             name: name.to_string(),
             message: m,
         };
-        let (axis, kind) = name
-            .split_once('.')
-            .ok_or_else(|| bad("expected <axis>.<kind>, e.g. z.guideway_normal".into()))?;
+        let (axis, kind) = name.rsplit_once('.').ok_or_else(|| {
+            bad("expected <axis>.<kind> or <body>.stiffness, e.g. z.guideway_normal".into())
+        })?;
+        if kind == "stiffness" {
+            let body = machine
+                .bodies()
+                .iter()
+                .position(|b| b.name == axis)
+                .ok_or_else(|| bad(format!("the machine {} has no body {axis}", machine.name())))?;
+            if machine.bodies()[body].elastic().is_none() {
+                return Err(bad(format!(
+                    "body {axis} is rigid: only an elastic body ([body.fe] or [body.beam]) has a stiffness factor"
+                )));
+            }
+            return Ok(Parameter {
+                name: name.to_string(),
+                kind: ParameterKind::BodyStiffness,
+                index: body,
+            });
+        }
         let axis: Axis = axis.parse().map_err(bad)?;
         let axis_index = machine
             .axes()
@@ -52,7 +74,7 @@ impl Parameter {
             "screw" => ParameterKind::Screw,
             _ => {
                 return Err(bad(format!(
-                    "unknown kind '{kind}' (guideway, guideway_normal, guideway_lateral, screw)"
+                    "unknown kind '{kind}' (guideway, guideway_normal, guideway_lateral, screw; <body>.stiffness for an elastic body)"
                 )))
             }
         };
@@ -65,8 +87,8 @@ impl Parameter {
         }
         Ok(Parameter {
             name: name.to_string(),
-            axis_index,
             kind,
+            index: axis_index,
         })
     }
 
@@ -80,12 +102,22 @@ impl Parameter {
             ] {
                 v.push(Parameter {
                     name: format!("{}.{suffix}", a.axis),
-                    axis_index: i,
                     kind,
+                    index: i,
                 });
             }
         }
         v
+    }
+
+    /// Index of its axis in [`Machine::axes`] (`None` for a body's stiffness).
+    pub fn axis_index(&self) -> Option<usize> {
+        (self.kind != ParameterKind::BodyStiffness).then_some(self.index)
+    }
+
+    /// Index of its body in [`Machine::bodies`] (`Some` for a body's stiffness only).
+    pub fn body_index(&self) -> Option<usize> {
+        (self.kind == ParameterKind::BodyStiffness).then_some(self.index)
     }
 
     /// The factor's value in `machine`.
@@ -94,13 +126,18 @@ impl Parameter {
             ParameterKind::Guideway | ParameterKind::GuidewayNormal => Reduction::GuidewayNormal,
             ParameterKind::GuidewayLateral => Reduction::GuidewayLateral,
             ParameterKind::Screw => Reduction::Screw,
+            ParameterKind::BodyStiffness => {
+                return machine.bodies()[self.index]
+                    .elastic()
+                    .map_or(1.0, |e| e.stiffness_factor())
+            }
         };
-        machine.reduction(self.axis_index, which)
+        machine.reduction(self.index, which)
     }
 
     /// Sets the factor in `machine` (finite and > 0).
     pub fn set(&self, machine: &mut Machine, value: f64) -> Result<(), MachineError> {
-        let i = self.axis_index;
+        let i = self.index;
         match self.kind {
             ParameterKind::Guideway => {
                 machine.set_reduction(i, Reduction::GuidewayNormal, value)?;
@@ -113,6 +150,7 @@ impl Parameter {
                 machine.set_reduction(i, Reduction::GuidewayLateral, value)
             }
             ParameterKind::Screw => machine.set_reduction(i, Reduction::Screw, value),
+            ParameterKind::BodyStiffness => machine.set_body_stiffness(i, value),
         }
     }
 }

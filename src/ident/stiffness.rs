@@ -15,6 +15,7 @@ impl ParameterKind {
             ParameterKind::GuidewayNormal => &[FactorKind::GuidewayNormal],
             ParameterKind::GuidewayLateral => &[FactorKind::GuidewayLateral],
             ParameterKind::Screw => &[FactorKind::Drive],
+            ParameterKind::BodyStiffness => &[],
         }
     }
 }
@@ -28,7 +29,9 @@ pub fn table_with_std_err<'a>(
     let mut table = StiffnessTable::of(machine);
     table.identified = true;
     for (p, std_err) in fitted {
-        let axis = machine.axes()[p.axis_index].axis;
+        let Some(axis) = p.axis_index().map(|i| machine.axes()[i].axis) else {
+            continue;
+        };
         for &kind in p.kind.factors() {
             table.set_factor_std_err(axis, kind, &p.name, std_err);
         }

@@ -5,14 +5,18 @@
 //! and validated once by [`Machine::from_raw`]; every later stage relies on the checks made here.
 //! Errors name the file and the key path (`axis[x].guideway.reduction_normal`).
 
+mod attach;
+pub mod body;
 pub mod catalogue;
 pub mod raw;
 pub mod stiffness;
 mod validate;
 
 use crate::axes::Axis;
+pub use attach::BodySite;
+pub use body::{Body, BodyKind, ElasticBody, ElasticModel, Site};
 use catalogue::{CarriageData, Catalogue};
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Vector3;
 use raw::{Feedback, RawMachine, Support};
 use std::path::Path;
 
@@ -71,21 +75,6 @@ impl Side {
             Side::Workpiece => -1.0,
         }
     }
-}
-
-/// A rigid body; free bodies have 6 DOF (x, y, z, a, b, c) at their centre of gravity.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Body {
-    /// Unique name.
-    pub name: String,
-    /// Fixed to the ground.
-    pub fixed: bool,
-    /// Mass, kg (0 for fixed bodies).
-    pub mass_kg: f64,
-    /// Centre of gravity at the reference position, m.
-    pub cog_m: Vector3<f64>,
-    /// Inertia tensor about the COG, kg·m².
-    pub inertia_kg_m2: Matrix3<f64>,
 }
 
 /// A point fixed to a body, at the reference position.

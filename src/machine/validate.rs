@@ -5,7 +5,8 @@
 use super::catalogue::Catalogue;
 use super::raw::{self, RawMachine, Support};
 use super::{
-    Body, BodyPoint, Control, Drive, Guideway, Joint, LinearAxis, Machine, MachineError, Rail, Side,
+    Body, BodyKind, BodyPoint, Control, Drive, Guideway, Joint, LinearAxis, Machine, MachineError,
+    Rail, Side,
 };
 use crate::axes::Axis;
 use nalgebra::{Matrix3, Vector3};
@@ -79,10 +80,10 @@ impl Machine {
             if b.fixed {
                 bodies.push(Body {
                     name: b.name.clone(),
-                    fixed: true,
                     mass_kg: b.mass_kg.unwrap_or(0.0),
                     cog_m: Vector3::from(cog),
                     inertia_kg_m2: Matrix3::zeros(),
+                    kind: BodyKind::Fixed,
                 });
                 continue;
             }
@@ -103,10 +104,10 @@ impl Machine {
             check_inertia(&inertia).map_err(|m| err(key("inertia_kg_m2"), m))?;
             bodies.push(Body {
                 name: b.name.clone(),
-                fixed: false,
                 mass_kg: mass,
                 cog_m: Vector3::from(cog),
                 inertia_kg_m2: inertia,
+                kind: BodyKind::Rigid,
             });
         }
         let body_index = |name: &str, key: String| {
@@ -161,7 +162,7 @@ impl Machine {
             if carrier == moving {
                 return Err(err(key("moving"), "moving body equals the carrier".into()));
             }
-            if bodies[moving].fixed {
+            if bodies[moving].is_fixed() {
                 return Err(err(key("moving"), format!("body '{}' is fixed", ra.moving)));
             }
             if let Some(other) = moved_by[moving] {

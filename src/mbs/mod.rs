@@ -1,8 +1,10 @@
 //! Multi-body assembly: mass, damping and stiffness matrices of the machine at an axis position.
 //!
-//! Each free body has 6 DOF q = (x, y, z, a, b, c) at its centre of gravity c (small rotations);
-//! each axis adds the rotor angle φ of its motor. A point p of a body moves by
-//! u(p) = T(p)·q with T(p) = [I, −skew(p − c)].
+//! Each free body has its coordinates ([`crate::machine::body`]): a rigid body the six
+//! q = (x, y, z, a, b, c) at its centre of gravity c (small rotations), an elastic body those and
+//! its elastic coordinates; each axis adds the rotor angle φ of its motor. The point where
+//! something attaches moves by u(p) = T(p)·q, with T(p) = [I, −skew(p − c)] on a rigid body; the
+//! assembly below only asks each body for T (and the rotation rows R), never for its kind.
 //!
 //! * A carriage is a spring/damper between the carriage point p of the moving body and the
 //!   coincident point of the carrier, stiff across the rail (normal n, lateral l), free along it:
@@ -16,11 +18,13 @@
 //! * Position dependence: at axis position s every body carried by the axis is shifted by
 //!   σ·(s − s_ref)·e (σ = +1 tool side, −1 workpiece side, ISO 841), which moves the carriage
 //!   contact points on the carrier and the nut on the screw (shaft stiffness E·A/l₁).
+//! * An elastic body adds its reduced stiffness and modal damping to its own block (not scaled
+//!   by the Rayleigh β, which is for the joints and guideways).
 
 pub mod modal;
 
-use crate::machine::Machine;
-use nalgebra::{DMatrix, DVector, Matrix3, SMatrix, Vector3};
+use crate::machine::{Machine, Site};
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
 /// Errors of the assembly and of the support check.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -61,6 +65,16 @@ pub enum MbsError {
         /// Dominant DOF of the first of them.
         dof: String,
     },
+    /// An elastic body has no attachment for something that acts on it.
+    #[error("{machine}: body '{body}' has no attachment for {site}")]
+    Attachment {
+        /// Machine source.
+        machine: String,
+        /// Body name.
+        body: String,
+        /// What attaches (`z.carriage[0]`).
+        site: String,
+    },
     /// The eigen-solver failed.
     #[error("{machine}: modal analysis failed: {reason}")]
     Eigen {
@@ -90,8 +104,11 @@ pub struct AxisPorts {
 /// The assembled linear model M q̈ + D q̇ + K q = f at one axis position.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Model {
-    /// DOF names: `body.x` … `body.c` per free body, then `axis.motor` per axis.
+    /// DOF names: `body.x` … `body.c` per free body (then `body.mode1` … for an elastic
+    /// one), then `axis.motor` per axis.
     pub dofs: Vec<String>,
+    /// Per body (machine order), the index of its first coordinate; `None` for a fixed body.
+    pub body_dofs: Vec<Option<usize>>,
     /// Mass matrix, SI.
     pub mass: DMatrix<f64>,
     /// Damping matrix, SI.
@@ -114,31 +131,33 @@ pub struct Model {
     pub machine: String,
 }
 
-/// T(p) = [I, −skew(p − c)]: displacement of point p of a body with DOF at c.
-fn point_map(p: &Vector3<f64>, c: &Vector3<f64>) -> SMatrix<f64, 3, 6> {
-    let r = p - c;
-    let mut t = SMatrix::<f64, 3, 6>::zeros();
-    t.fixed_view_mut::<3, 3>(0, 0).fill_with_identity();
-    t.fixed_view_mut::<3, 3>(0, 3)
-        .copy_from(&(-r.cross_matrix()));
-    t
-}
+/// One side of a two-point element: the body's first coordinate and the 6 × w motion of the
+/// point ([`crate::machine::Body::point_motion`]), or nothing for a fixed body.
+type Port = Option<(usize, DMatrix<f64>)>;
 
-/// One side of a two-point element: DOF offset and point map, or nothing for a fixed body.
-type Port = Option<(usize, SMatrix<f64, 3, 6>)>;
-
-/// Adds Gᵀ k G with G = [T_a, −T_b] for a 3×3 spring/damper matrix k.
+/// Adds Gᵀ k G with G = [T_a, −T_b] for a 3×3 spring/damper matrix k, T the translation rows
+/// of each side's point motion.
 fn add_point_element(target: &mut DMatrix<f64>, a: &Port, b: &Port, k: &Matrix3<f64>) {
     let sides = [(a, 1.0), (b, -1.0)];
     for (pi, si) in &sides {
         let Some((i, ti)) = pi else { continue };
+        let ti = ti.rows(0, 3);
         for (pj, sj) in &sides {
             let Some((j, tj)) = pj else { continue };
+            let tj = tj.rows(0, 3);
             let block = ti.transpose() * k * tj * (si * sj);
-            let mut view = target.view_mut((*i, *j), (6, 6));
+            let mut view = target.view_mut((*i, *j), block.shape());
             view += block;
         }
     }
+}
+
+/// The generalised force of a unit axial drive force at a point with motion `t` (6 × w):
+/// Tᵀe for the force along e plus, for a right-hand thread of h = lead/(2π) m/rad, the torque
+/// −h·e that comes with it, −h·Rᵀe (R the rotation rows).
+fn screw_force(t: &DMatrix<f64>, e: &Vector3<f64>, h: f64) -> DVector<f64> {
+    let twist = t.rows(3, 3).transpose() * e * h;
+    t.rows(0, 3).transpose() * e - twist
 }
 
 impl Model {
@@ -176,12 +195,12 @@ impl Model {
                     .sum()
             })
             .collect();
-        let mut body_dof = vec![None; nb];
+        let mut body_dofs = vec![None; nb];
         let mut dofs = Vec::new();
         for (b, body) in machine.bodies().iter().enumerate() {
-            if !body.fixed {
-                body_dof[b] = Some(dofs.len());
-                for d in ["x", "y", "z", "a", "b", "c"] {
+            if body.width() > 0 {
+                body_dofs[b] = Some(dofs.len());
+                for d in body.coordinate_names() {
                     dofs.push(format!("{}.{d}", body.name));
                 }
             }
@@ -191,26 +210,27 @@ impl Model {
             dofs.push(format!("{}.motor", a.axis));
         }
         let n = dofs.len();
-        let cog: Vec<Vector3<f64>> = (0..nb)
-            .map(|b| machine.bodies()[b].cog_m + shift[b])
-            .collect();
-        // A point of body b given at the reference position, at this pose.
-        let port = |b: usize, p_ref: &Vector3<f64>| -> Port {
-            body_dof[b].map(|i| (i, point_map(&(p_ref + shift[b]), &cog[b])))
-        };
-        // A point given on body `on`, seen as the coincident point of body `b`.
-        let port_at = |b: usize, p: &Vector3<f64>| -> Port {
-            body_dof[b].map(|i| (i, point_map(p, &cog[b])))
+        // Where `site` on body b lies at this pose (machine coordinates `p`): its motion.
+        let port = |b: usize, site: Site, p: &Vector3<f64>| -> Result<Port, MbsError> {
+            let Some(i) = body_dofs[b] else {
+                return Ok(None);
+            };
+            let body = &machine.bodies()[b];
+            match body.point_motion(site, p, &shift[b]) {
+                Some(t) => Ok(Some((i, t))),
+                None => Err(MbsError::Attachment {
+                    machine: machine.source().to_string(),
+                    body: body.name.clone(),
+                    site: site.to_string(),
+                }),
+            }
         };
 
         let mut mass = DMatrix::zeros(n, n);
         for (b, body) in machine.bodies().iter().enumerate() {
-            if let Some(i) = body_dof[b] {
-                for d in 0..3 {
-                    mass[(i + d, i + d)] = body.mass_kg;
-                }
-                mass.view_mut((i + 3, i + 3), (3, 3))
-                    .copy_from(&body.inertia_kg_m2);
+            if let Some(i) = body_dofs[b] {
+                let m = body.mass_matrix();
+                mass.view_mut((i, i), m.shape()).copy_from(&m);
             }
         }
         let mut stiffness = DMatrix::zeros(n, n);
@@ -222,20 +242,27 @@ impl Model {
             let g = &a.guideway;
             let kn = g.normal_n_per_m * g.reduction_normal;
             let kl = g.lateral_n_per_m * g.reduction_lateral;
+            let mut index = 0;
             for rail in &g.rails {
                 let nn = rail.normal * rail.normal.transpose();
                 let ll = rail.lateral * rail.lateral.transpose();
                 let k = nn * kn + ll * kl;
                 let c = nn * g.damping_normal_n_s_per_m + ll * g.damping_lateral_n_s_per_m;
                 for p_ref in &rail.carriages_m {
+                    let site = Site::Carriage {
+                        axis: a.axis,
+                        index,
+                    };
+                    index += 1;
+                    // The carriage and the point of the carrier's rail under it.
                     let p = p_ref + shift[a.moving];
-                    let pm = port(a.moving, p_ref);
-                    let pc = port_at(a.carrier, &p);
+                    let pm = port(a.moving, site, &p)?;
+                    let pc = port(a.carrier, site, &p)?;
                     add_point_element(&mut stiffness, &pm, &pc, &k);
                     add_point_element(&mut damping, &pm, &pc, &c);
                 }
             }
-            // Screw: δ = eᵀ(u_m(p_nut) − u_c(p_nut)) − φ·h/(2π).
+            // Screw: δ = eᵀ(u_m(p_nut) − u_c(p_nut)) − (φ + eᵀ(θ_m − θ_c))·h/(2π).
             let d = &a.drive;
             let nut = d.nut_m + shift[a.moving];
             let bearing = d.bearing_m + shift[a.carrier];
@@ -247,14 +274,13 @@ impl Model {
             // θ·h/(2π) along e, so the spring force F on the nut comes with the torque −F·h/(2π)·e,
             // and its reaction acts on the carrier (screw bearing and motor stator).
             let h = d.transmission_m_per_rad();
-            let mut twist = SMatrix::<f64, 6, 1>::zeros();
-            twist.fixed_rows_mut::<3>(3).copy_from(&(e * h));
-            if let Some((i, t)) = port(a.moving, &d.nut_m) {
-                gvec.rows_mut(i, 6).copy_from(&(t.transpose() * e - twist));
+            if let Some((i, t)) = port(a.moving, Site::Nut(a.axis), &nut)? {
+                gvec.rows_mut(i, t.ncols())
+                    .copy_from(&screw_force(&t, &e, h));
             }
-            if let Some((i, t)) = port_at(a.carrier, &nut) {
-                let mut rows = gvec.rows_mut(i, 6);
-                rows -= t.transpose() * e - twist;
+            if let Some((i, t)) = port(a.carrier, Site::Nut(a.axis), &nut)? {
+                let mut rows = gvec.rows_mut(i, t.ncols());
+                rows -= screw_force(&t, &e, h);
             }
             gvec[rotor] = -d.transmission_m_per_rad();
             stiffness.ger(k_ax, &gvec, &gvec, 1.0);
@@ -266,12 +292,14 @@ impl Model {
             let sigma = a.side.sign();
             let mut scale = DVector::zeros(n);
             let ps = d.scale_m + shift[a.moving];
-            if let Some((i, t)) = port(a.moving, &d.scale_m) {
-                scale.rows_mut(i, 6).copy_from(&(t.transpose() * e * sigma));
+            if let Some((i, t)) = port(a.moving, Site::Scale(a.axis), &ps)? {
+                scale
+                    .rows_mut(i, t.ncols())
+                    .copy_from(&(t.rows(0, 3).transpose() * e * sigma));
             }
-            if let Some((i, t)) = port_at(a.carrier, &ps) {
-                let mut rows = scale.rows_mut(i, 6);
-                rows -= t.transpose() * e * sigma;
+            if let Some((i, t)) = port(a.carrier, Site::Scale(a.axis), &ps)? {
+                let mut rows = scale.rows_mut(i, t.ncols());
+                rows -= t.rows(0, 3).transpose() * e * sigma;
             }
             let mut encoder = DVector::zeros(n);
             encoder[rotor] = sigma * d.transmission_m_per_rad();
@@ -284,38 +312,48 @@ impl Model {
             });
         }
 
-        for j in machine.joints() {
+        for (ji, j) in machine.joints().iter().enumerate() {
             let p = j.point_m + shift[j.body];
             let k = Matrix3::from_diagonal(&j.stiffness_n_per_m);
             let c = Matrix3::from_diagonal(&j.damping_n_s_per_m);
-            let pa = port_at(j.body, &p);
-            let pb = port_at(j.other, &p);
+            let pa = port(j.body, Site::Joint(ji), &p)?;
+            let pb = port(j.other, Site::Joint(ji), &p)?;
             add_point_element(&mut stiffness, &pa, &pb, &k);
             add_point_element(&mut damping, &pa, &pb, &c);
         }
         if machine.rayleigh_beta_s() > 0.0 {
             damping += &stiffness * machine.rayleigh_beta_s();
         }
+        // The bodies' own elastic stiffness and modal damping (after the Rayleigh term: their
+        // damping is given as a modal ratio of their own).
+        for (b, body) in machine.bodies().iter().enumerate() {
+            if let (Some(i), Some((k, c))) = (body_dofs[b], body.elastic_matrices()) {
+                let mut view = stiffness.view_mut((i, i), k.shape());
+                view += k;
+                let mut view = damping.view_mut((i, i), c.shape());
+                view += c;
+            }
+        }
 
         let mut tcp = DMatrix::zeros(3, n);
-        if let Some((i, t)) = port(machine.tcp().body, &machine.tcp().point_m) {
-            tcp.view_mut((0, i), (3, 6)).copy_from(&t);
+        let tcp_point = machine.tcp().point_m + shift[machine.tcp().body];
+        if let Some((i, t)) = port(machine.tcp().body, Site::Tcp, &tcp_point)? {
+            tcp.view_mut((0, i), (3, t.ncols()))
+                .copy_from(&t.rows(0, 3));
         }
         // The nest is set up under the tool at this circle centre: the point of the workpiece
         // body that coincides with the TCP at this pose (CONTRACT: x_ext_mm).
-        let nest = machine.tcp().point_m + shift[machine.tcp().body];
-        if let Some((i, t)) = port_at(machine.workpiece().body, &nest) {
-            let mut v = tcp.view_mut((0, i), (3, 6));
-            v -= t;
-        }
         let mut nest_rotation = DMatrix::zeros(3, n);
-        if let Some(i) = body_dof[machine.workpiece().body] {
+        if let Some((i, t)) = port(machine.workpiece().body, Site::Workpiece, &tcp_point)? {
+            let mut v = tcp.view_mut((0, i), (3, t.ncols()));
+            v -= t.rows(0, 3);
             nest_rotation
-                .view_mut((0, i + 3), (3, 3))
-                .fill_with_identity();
+                .view_mut((0, i), (3, t.ncols()))
+                .copy_from(&t.rows(3, 3));
         }
         Ok(Model {
             dofs,
+            body_dofs,
             mass,
             damping,
             stiffness,
@@ -338,17 +376,14 @@ impl Model {
     pub fn drive_mode(&self, machine: &Machine, i: usize) -> DVector<f64> {
         let a = &machine.axes()[i];
         let mut v = DVector::zeros(self.n_dof());
-        let mut dof = 0;
+        let none = Vector3::zeros();
         for (b, body) in machine.bodies().iter().enumerate() {
-            if body.fixed {
-                continue;
-            }
-            if machine.is_carried_by(b, i) {
-                for (d, e) in a.axis.unit().iter().enumerate() {
-                    v[dof + d] = *e;
+            if let Some(first) = self.body_dofs[b] {
+                if machine.is_carried_by(b, i) {
+                    let q = body.rigid_coordinates(&a.direction(), &none);
+                    v.rows_mut(first, q.len()).copy_from(&q);
                 }
             }
-            dof += 6;
         }
         v[self.axes[i].rotor_dof] = 1.0 / machine.axes()[i].drive.transmission_m_per_rad();
         v

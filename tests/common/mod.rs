@@ -10,6 +10,7 @@ pub mod random_machine;
 pub mod synth;
 
 use eij::machine::Machine;
+use eij::mbs::Model;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -39,6 +40,38 @@ pub fn demo() -> Machine {
 /// The demo machine file's text (for variations of it).
 pub fn demo_text() -> String {
     std::fs::read_to_string(root().join(DEMO)).unwrap()
+}
+
+/// The rigid motion of every free body together, as a small rotation `rot` about the point `o`
+/// plus a translation `tr` (rotors held relative to their carriers; elastic coordinates zero).
+pub fn whole_machine_motion(
+    machine: &Machine,
+    model: &Model,
+    pose: &[f64],
+    tr: nalgebra::Vector3<f64>,
+    rot: nalgebra::Vector3<f64>,
+    o: nalgebra::Vector3<f64>,
+) -> nalgebra::DVector<f64> {
+    let mut v = nalgebra::DVector::zeros(model.n_dof());
+    for (b, body) in machine.bodies().iter().enumerate() {
+        let Some(i) = model.body_dofs[b] else {
+            continue;
+        };
+        // The body's COG at this pose: shifted by every axis that carries it.
+        let mut c = body.cog_m;
+        for (ai, a) in machine.axes().iter().enumerate() {
+            if machine.is_carried_by(b, ai) {
+                c += a.direction() * (a.side.sign() * (pose[ai] - a.reference_m));
+            }
+        }
+        // Rigid coordinates at the COG (elastic ones, if any, stay zero).
+        let u = tr + rot.cross(&(c - o));
+        for d in 0..3 {
+            v[i + d] = u[d];
+            v[i + 3 + d] = rot[d];
+        }
+    }
+    v
 }
 
 /// A scratch folder, emptied on creation and removed on drop.
