@@ -17,7 +17,7 @@
 
 use crate::axes::{Axis, Direction, Eij, Plane};
 use crate::machine::Machine;
-use crate::map::{eij_map, AxisGrid, MapError, MapSpec};
+use crate::map::{eij_map_with_progress, AxisGrid, MapError, MapSpec};
 use crate::sim::setpoint::SetPoint;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -135,6 +135,16 @@ impl CompensationTable {
     /// the strokes, from circle tests (ccw, `spec.radius_mm`, `spec.accel_m_s2`) in the three
     /// planes; an EIJ that two planes give (J in both) is their mean.
     pub fn of(machine: &Machine, spec: &TableSpec) -> Result<Self, CompensationError> {
+        Self::of_with_progress(machine, spec, &|_, _| {})
+    }
+
+    /// As [`CompensationTable::of`], calling `progress(done, total)` with the circles
+    /// simulated so far (for a progress bar).
+    pub fn of_with_progress(
+        machine: &Machine,
+        spec: &TableSpec,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<Self, CompensationError> {
         let setting = |key: &str, message: String| CompensationError::Setting {
             key: key.to_string(),
             message,
@@ -173,18 +183,22 @@ impl CompensationTable {
             .collect();
         // EIJ samples per parameter: (positions in mm, values), summed over the planes.
         let mut sums: BTreeMap<Eij, (Vec<[f64; 3]>, Vec<f64>, Vec<u32>)> = BTreeMap::new();
-        for plane in Plane::ALL {
-            let (a, b) = plane.axes();
-            if machine.axis(a).is_none() || machine.axis(b).is_none() {
-                continue;
-            }
+        let planes: Vec<Plane> = Plane::ALL
+            .into_iter()
+            .filter(|p| machine.axis(p.axes().0).is_some() && machine.axis(p.axes().1).is_some())
+            .collect();
+        let per_plane = grids.iter().map(|g| g.values_m.len()).product::<usize>();
+        for (k, &plane) in planes.iter().enumerate() {
             let map_spec = MapSpec {
                 plane,
                 direction: Direction::Ccw,
                 radius_m: spec.radius_mm * 1e-3,
                 accel_m_s2: spec.accel_m_s2,
             };
-            let points = eij_map(machine, &grids, &map_spec)?;
+            let total = planes.len() * per_plane;
+            let points = eij_map_with_progress(machine, &grids, &map_spec, &|done, _| {
+                progress(k * per_plane + done, total)
+            })?;
             for (e, _) in points[0].eij.iter() {
                 if machine.axis(e.deviation).is_none() {
                     continue;

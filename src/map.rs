@@ -26,9 +26,9 @@ pub enum MapError {
         /// What is wrong.
         message: String,
     },
-    /// A grid point the model cannot be evaluated at.
+    /// A grid point the model cannot be evaluated at (boxed: the error is large).
     #[error(transparent)]
-    Predict(#[from] PredictError),
+    Predict(Box<PredictError>),
     /// A map table that cannot be read.
     #[error("{at}: {message}")]
     Table {
@@ -37,6 +37,12 @@ pub enum MapError {
         /// What is wrong.
         message: String,
     },
+}
+
+impl From<PredictError> for MapError {
+    fn from(e: PredictError) -> Self {
+        MapError::Predict(Box::new(e))
+    }
 }
 
 /// Most grid points of one map (all grids multiplied): bounds time and memory; a compensation
@@ -121,6 +127,20 @@ pub fn eij_map(
     grids: &[AxisGrid],
     spec: &MapSpec,
 ) -> Result<Vec<MapPoint>, MapError> {
+    eij_map_with_progress(machine, grids, spec, &|_, _| {})
+}
+
+/// Grid points simulated between two calls of a map's progress callback.
+const PROGRESS_CHUNK: usize = 64;
+
+/// As [`eij_map`], calling `progress(done, total)` with the grid points simulated so far (for
+/// a progress bar; every [`PROGRESS_CHUNK`] points).
+pub fn eij_map_with_progress(
+    machine: &Machine,
+    grids: &[AxisGrid],
+    spec: &MapSpec,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<Vec<MapPoint>, MapError> {
     let (a, b) = spec.plane.axes();
     for ax in [a, b] {
         if machine.axis(ax).is_none() {
@@ -195,12 +215,18 @@ pub fn eij_map(
             .at(p.clone())
         })
         .collect();
-    let sims = simulated_eij(
-        std::slice::from_ref(machine),
-        &tests,
-        &SimSettings::default(),
-    )?
-    .remove(0);
+    let mut sims = Vec::with_capacity(tests.len());
+    for chunk in tests.chunks(PROGRESS_CHUNK) {
+        sims.extend(
+            simulated_eij(
+                std::slice::from_ref(machine),
+                chunk,
+                &SimSettings::default(),
+            )?
+            .remove(0),
+        );
+        progress(sims.len(), tests.len());
+    }
     Ok(positions
         .into_iter()
         .zip(sims)

@@ -41,7 +41,12 @@ pub fn run(args: CompensationArgs) -> anyhow::Result<()> {
         accel_m_s2: args.accel_m_s2,
         points: args.points,
     };
-    let table = CompensationTable::of(&machine, &spec)?;
+    let bar = super::console::Progress::bar(0, "compensation", "circles");
+    let table = CompensationTable::of_with_progress(&machine, &spec, &|done, total| {
+        bar.set_len(total as u64);
+        bar.set(done as u64);
+    })?;
+    drop(bar);
     for c in &table.coefficients {
         let worst = c.worst_residual_um_s2_per_m;
         if worst > WARN_RESIDUAL && worst > 0.1 * c.offset_um_s2_per_m.abs() {

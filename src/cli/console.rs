@@ -94,3 +94,67 @@ pub fn wrote(paths: &[&std::path::Path]) {
     let list: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
     status(format_args!("wrote {}", list.join(", ")));
 }
+
+/// A progress bar on standard error while it lives (cleared when dropped): only on a terminal
+/// and without `--quiet`; piped or quiet, nothing is drawn.
+pub struct Progress(Option<indicatif::ProgressBar>);
+
+impl Progress {
+    /// A bar of `len` steps: `map 1200/3111 grid points [2s]`.
+    pub fn bar(len: u64, what: &str, unit: &str) -> Progress {
+        Progress::new(|| {
+            let bar = indicatif::ProgressBar::new(len);
+            bar.set_style(
+                indicatif::ProgressStyle::with_template(&format!(
+                    "{what} {{wide_bar}} {{pos}}/{{len}} {unit} [{{elapsed}}, ~{{eta}} left]"
+                ))
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+            );
+            bar
+        })
+    }
+
+    /// A spinner for work without a count: `report: evaluating 36 circle tests [2s]`.
+    pub fn spinner(what: &str) -> Progress {
+        Progress::new(|| {
+            let bar = indicatif::ProgressBar::new_spinner();
+            bar.set_style(
+                indicatif::ProgressStyle::with_template("{spinner} {msg} [{elapsed}]")
+                    .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner()),
+            );
+            bar.set_message(what.to_string());
+            bar.enable_steady_tick(std::time::Duration::from_millis(120));
+            bar
+        })
+    }
+
+    fn new(make: impl FnOnce() -> indicatif::ProgressBar) -> Progress {
+        use std::io::IsTerminal;
+        if quiet() || !std::io::stderr().is_terminal() {
+            return Progress(None);
+        }
+        Progress(Some(make()))
+    }
+
+    /// Sets the position (steps done).
+    pub fn set(&self, done: u64) {
+        if let Some(b) = &self.0 {
+            b.set_position(done);
+        }
+    }
+
+    /// Sets the number of steps.
+    pub fn set_len(&self, len: u64) {
+        if let Some(b) = &self.0 {
+            b.set_length(len);
+        }
+    }
+}
+
+impl Drop for Progress {
+    fn drop(&mut self) {
+        if let Some(b) = &self.0 {
+            b.finish_and_clear();
+        }
+    }
+}

@@ -87,7 +87,10 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<()> {
         fallback_radius_mm: None,
         fit_time_offset: args.fit_time_offset,
     };
+    let spinner =
+        super::console::Progress::spinner(&format!("evaluate: {} circle test(s)", tests.len()));
     let suite = suite::evaluate_tests(&tests, &opts).map_err(super::advice::evaluate)?;
+    drop(spinner);
     let pooled = if args.pooled {
         let refs: Vec<&CircleSeries> = suite.tests.iter().map(|t| &t.series).collect();
         let radius_mm = suite

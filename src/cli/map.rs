@@ -4,7 +4,7 @@ use super::machine_args::write_outputs;
 use anyhow::bail;
 use eij::axes::{Direction, Plane};
 use eij::machine::Machine;
-use eij::map::{eij_map, to_csv, AxisGrid, MapSpec};
+use eij::map::{eij_map_with_progress, to_csv, AxisGrid, MapSpec};
 use std::path::PathBuf;
 
 /// Arguments of `eij map`.
@@ -68,7 +68,11 @@ pub fn run(args: MapArgs) -> anyhow::Result<()> {
         radius_m: args.radius_mm * 1e-3,
         accel_m_s2: args.accel_m_s2,
     };
-    let points = eij_map(&machine, &grids, &spec).map_err(super::advice::map)?;
+    let total: usize = grids.iter().map(|g| g.values_m.len()).product();
+    let bar = super::console::Progress::bar(total as u64, "map", "grid points");
+    let points = eij_map_with_progress(&machine, &grids, &spec, &|done, _| bar.set(done as u64))
+        .map_err(super::advice::map)?;
+    drop(bar);
     let axes: Vec<_> = machine.axes().iter().map(|a| a.axis).collect();
     let svg = match &args.plot {
         Some(_) => Some(eij::report::map_svg(

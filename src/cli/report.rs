@@ -5,12 +5,19 @@ use std::path::PathBuf;
 
 use eij::report::{self, ReportRequest};
 
-/// Arguments of `eij report`.
+/// Arguments of `eij report`: at least one of `--measured`, `--identify-report`, `--move`,
+/// `--map`.
 #[derive(Debug, clap::Args)]
+#[command(group(
+    clap::ArgGroup::new("inputs")
+        .required(true)
+        .multiple(true)
+        .args(["measured", "identify_report", "moves", "maps"])
+))]
 pub struct ReportArgs {
     /// R-Test CSV files or folders of them (folders: every *.csv, sorted; a folder's
     /// rtest.toml gives the set radius and the circle centre position).
-    #[arg(long, value_name = "PATH", num_args = 1.., required = true)]
+    #[arg(long, value_name = "PATH", num_args = 1..)]
     measured: Vec<PathBuf>,
     /// Report JSON of `eij identify --report`: verdict, parameters, correlations, per-test
     /// table and figure. Repeatable: several reports (before/after a repair, two machines, two
@@ -35,6 +42,7 @@ pub fn run(args: ReportArgs) -> anyhow::Result<()> {
     if args.out.is_dir() {
         eij::io::check_outputs(&[&args.out.join(report::html::REPORT_FILE)], &[])?;
     }
+    let spinner = super::console::Progress::spinner("report: reading, evaluating and drawing");
     let page = report::generate(&ReportRequest {
         measured: args.measured,
         identify_reports: args.identify_report,
@@ -42,6 +50,7 @@ pub fn run(args: ReportArgs) -> anyhow::Result<()> {
         extra_figures: map_figures(&args.maps)?,
         out_dir: args.out,
     })?;
+    drop(spinner);
     super::console::status(format_args!(
         "wrote {} (one page, figures inline)",
         page.display()

@@ -283,7 +283,9 @@ fn run_move(common: &Common, mv: &JerkLimitedMove) -> anyhow::Result<()> {
         Some(c) => c,
         None => mv,
     };
+    let spinner = super::console::Progress::spinner("simulate: the move");
     let run = eij::sim::simulate_segments(&segments, sp)?;
+    drop(spinner);
     let cl = &segments[0].closed_loop;
     let correction = comp.as_ref().map(|c| corrections(c, cl, &run));
     write_output_files(common, cl, run, PlotKind::Move(mv.axis), cond, correction)
@@ -312,10 +314,12 @@ fn run_setpoint(
     if common.plot.is_none() {
         return stream_csv(common, &cl, sp, comp.as_ref(), rate);
     }
+    let spinner = super::console::Progress::spinner("simulate: the circle");
     let run = match &comp {
         Some(c) => simulate(&cl, c, rate)?,
         None => simulate(&cl, sp, rate)?,
     };
+    drop(spinner);
     let correction = comp.as_ref().map(|c| corrections(c, &cl, &run));
     write_output_files(
         common,
@@ -374,12 +378,18 @@ fn stream_csv(
     };
     // A write that fails (a full disk) names the output.
     let cannot_write = || format!("{}: cannot write", common.out.display());
+    let duration_s = setpoint.duration_s();
+    let bar = super::console::Progress::bar((duration_s * 1e3) as u64, "simulate", "ms");
     eij::sim::simulate_blocks(cl, setpoint, rate, |block| -> anyhow::Result<()> {
+        if let Some(t) = block.t_s.last() {
+            bar.set((t * 1e3) as u64);
+        }
         let correction = comp.map(|c| corrections(c, cl, block));
         csv.write(block, correction.as_deref())
             .with_context(cannot_write)?;
         Ok(())
     })?;
+    drop(bar);
     csv.finish().with_context(cannot_write)?;
     out.commit()?;
     super::console::wrote(&[&common.out]);

@@ -24,6 +24,12 @@ pub enum WriteError {
         /// The underlying I/O error.
         cause: std::io::Error,
     },
+    /// The output path ends in a path separator, which names a folder, not a file.
+    #[error("{path}: ends in a path separator, so it names a folder; give a file name")]
+    EndsInSeparator {
+        /// The output path asked for.
+        path: PathBuf,
+    },
     /// The output path names an existing folder.
     #[error("{path}: is a folder, not a file")]
     IsAFolder {
@@ -183,6 +189,14 @@ pub fn check_outputs(outputs: &[&Path], inputs: &[&Path]) -> Result<(), WriteErr
     let mut seen: Vec<PathBuf> = Vec::new();
     for path in outputs {
         let out = path.to_path_buf();
+        // `out/` names a folder whether or not it exists (`Path` would read it as `out`).
+        let text = path.as_os_str().as_encoded_bytes();
+        if text
+            .last()
+            .is_some_and(|b| std::path::is_separator(char::from(*b)))
+        {
+            return Err(WriteError::EndsInSeparator { path: out });
+        }
         if path.file_name().is_none() {
             return Err(WriteError::IsAFolder { path: out });
         }

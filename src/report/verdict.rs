@@ -125,7 +125,10 @@ fn standing_class(s: Standing) -> &'static str {
     }
 }
 
-/// `accepted (exported)` or `REFUSED (nothing exported): …`.
+/// `accepted: the machine file was exported` or `REFUSED (nothing exported): …`. Only a
+/// refusal is coloured (red, like its verdict): whether an exported result may be used is the
+/// verdict's to say, in the verdict's one colour, never a second, green "accepted" beside a
+/// red verdict.
 pub fn status_html(id: &LoadedIdent) -> String {
     if id.refused() {
         format!(
@@ -133,14 +136,10 @@ pub fn status_html(id: &LoadedIdent) -> String {
             escape(id.report.refusal.as_deref().unwrap_or(""))
         )
     } else {
+        let status = id.report.status.as_deref().unwrap_or("status not recorded");
         format!(
-            "<span class=\"ok\">{}</span>",
-            escape(
-                id.report
-                    .status
-                    .as_deref()
-                    .unwrap_or("accepted (status not recorded)")
-            )
+            "{}: the identified machine file was exported (the fit converged within the bounds); whether to use it: see the verdict",
+            escape(status)
         )
     }
 }
