@@ -369,3 +369,31 @@ fn a_rigid_motion_of_the_whole_machine_is_neither_deviation_nor_scale_reading() 
         }
     }
 }
+
+#[test]
+fn kinetic_energy_holds_the_rotor_spinning_with_its_carrier() {
+    // ½ vᵀ M v against the kinetic energy written out: every free body ½(m |u̇|² + ωᵀ J ω) at
+    // its centre of gravity, every rotor ½ J_rotor (φ̇ + e·ω_carrier)², φ being measured
+    // against the stator on the carrier (the X motor sits on the saddle, Y and Z on the bed).
+    let machine = load("demo-vmc.toml");
+    let model = Model::assemble(&machine, &[0.1, -0.2, 0.05]).unwrap();
+    let n = model.n_dof();
+    let v = nalgebra::DVector::from_fn(n, |i, _| ((i * 7 + 3) % 11) as f64 / 11.0 - 0.4);
+    let mut energy = 0.0;
+    for (b, body) in machine.bodies().iter().enumerate() {
+        if let Some(i) = model.body_dofs[b] {
+            let u = v.fixed_rows::<3>(i);
+            let w = v.fixed_rows::<3>(i + 3);
+            energy += 0.5
+                * (body.mass_kg * u.norm_squared() + (w.transpose() * body.inertia_kg_m2 * w)[0]);
+        }
+    }
+    for (ai, a) in machine.axes().iter().enumerate() {
+        let carrier_spin = model.body_dofs[a.carrier]
+            .map_or(0.0, |i| a.direction().dot(&v.fixed_rows::<3>(i + 3)));
+        let spin = v[model.axes[ai].rotor_dof] + carrier_spin;
+        energy += 0.5 * a.drive.rotor_inertia_kg_m2 * spin * spin;
+    }
+    let got = 0.5 * v.dot(&(&model.mass * &v));
+    assert_rel(got, energy, 1e-13);
+}

@@ -13,7 +13,8 @@
 //!   whose axial position is φ·h/(2π): δ = eᵀ(u_moving(p_nut) − u_carrier(p_nut))
 //!   − (φ + eᵀ(θ_moving − θ_carrier))·h/(2π), K += k_ax·g gᵀ (right-hand thread, φ the rotor
 //!   angle relative to the carrier): the screw force F on the nut comes with the torque
-//!   −F·h/(2π) about e on the moving body and its reaction on the carrier. The drive force acts along the screw line, offset from the centre of gravity:
+//!   −F·h/(2π) about e on the moving body and its reaction on the carrier. The rotor (inertia J)
+//!   spins at φ̇ + eᵀω_carrier, its stator being on the carrier: M += J·s sᵀ over (φ, carrier). The drive force acts along the screw line, offset from the centre of gravity:
 //!   accelerating the axis tilts the slide — the acceleration correlated error eij is about.
 //! * Position dependence: at axis position s every body carried by the axis is shifted by
 //!   σ·(s − s_ref)·e (σ = +1 tool side, −1 workpiece side, ISO 841), which moves the carriage
@@ -278,14 +279,22 @@ impl Model {
                 gvec.rows_mut(i, t.ncols())
                     .copy_from(&screw_force(&t, &e, h));
             }
+            // φ is measured against the stator on the carrier, so the rotor spins at
+            // φ̇ + eᵀω_carrier: kinetic energy J(φ̇ + eᵀω_c)²/2, M += J·s sᵀ with s the unit on φ
+            // plus Rᵀe on the carrier (its rotation about the screw axis at the motor).
+            let mut spin = DVector::zeros(n);
+            spin[rotor] = 1.0;
             if let Some((i, t)) = port(a.carrier, Site::Nut(a.axis), &nut)? {
                 let mut rows = gvec.rows_mut(i, t.ncols());
                 rows -= screw_force(&t, &e, h);
+                spin.rows_mut(i, t.ncols())
+                    .copy_from(&(t.rows(3, 3).transpose() * e));
             }
             gvec[rotor] = -d.transmission_m_per_rad();
             stiffness.ger(k_ax, &gvec, &gvec, 1.0);
             damping.ger(d.damping_n_s_per_m, &gvec, &gvec, 1.0);
-            mass[(rotor, rotor)] = d.rotor_inertia_kg_m2;
+            mass.ger(d.rotor_inertia_kg_m2, &spin, &spin, 1.0);
+            // Friction acts on the rotor's speed relative to its stator, φ̇.
             damping[(rotor, rotor)] += d.friction_nm_s_per_rad;
 
             // Linear scale: σ·eᵀ(u_m(p_s) − u_c(p_s)), in axis coordinates.
