@@ -302,7 +302,7 @@ impl CompensationTable {
             .from_reader(text.as_bytes());
         let header: Vec<String> = rdr
             .headers()
-            .map_err(|e| err("header".into(), crate::rtest::layout::csv_message(&e)))?
+            .map_err(|e| err("header".into(), crate::io::delimited::csv_message(&e)))?
             .iter()
             .map(str::to_string)
             .collect();
@@ -333,7 +333,7 @@ impl CompensationTable {
                 let at = e
                     .position()
                     .map_or("CSV".to_string(), |p| format!("line {}", p.line()));
-                err(at, crate::rtest::layout::csv_message(&e))
+                err(at, crate::io::delimited::csv_message(&e))
             })?;
             let line = rec.position().map_or(0, |p| p.line());
             let at = || format!("line {line}");

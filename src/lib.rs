@@ -4,22 +4,33 @@
 //! the model predicts the acceleration correlated position errors `EIJ` at the tool centre point
 //! (deviation in direction I per set acceleration of axis J, µm·s²/m).
 //!
-//! The module tree follows the data path:
+//! The module tree follows the data path; a module imports only from its own stage and the
+//! stages before it (`tests/architecture.rs` checks this, and that no import circle exists):
 //!
 //! ```text
-//! machine ─► mbs ─► control ─► sim ─► rtest ─► predict ─► ident ─► report
+//! text, axes, io ─► fe ─► machine ─► mbs ─► control ─► rtest ─► sim ─► measured
+//!                ─► predict ─► ident ─► map ─► compensation ─► report ─► cli
 //! ```
 //!
+//! * [`text`], [`axes`], [`io`]: numbers in messages, the names shared along the data path
+//!   (axes, planes, EIJ), files in and out (size limits, atomic outputs, delimited text).
+//! * [`fe`]: elastic bodies from finite-element models, reduced (Craig–Bampton) to the
+//!   coordinates of the multi-body model.
 //! * [`machine`]: the validated machine description (bodies, axes, guideways, drives, control),
 //!   read from TOML with catalogue look-up of carriage stiffness.
 //! * [`mbs`]: assembly of the mass, damping and stiffness matrices at an axis position; modal
 //!   analysis.
 //! * [`control`]: drives under cascaded P-PI control; the closed loop in state space.
+//! * [`rtest`]: the evaluation of R-Test circle tests into EIJ with standard errors (the math
+//!   alone; before `sim`, which hands its runs over as the evaluation's `CircleSeries`).
 //! * [`sim`]: set points (circle, jerk-limited move) and exact time-domain discretisation.
-//! * [`rtest`]: reading and evaluating R-Test circle tests into EIJ with standard errors.
+//! * [`measured`]: what was measured, read from files (CSV layouts, `rtest.toml` conditions,
+//!   two-system recordings, EIJ tables and JSON, moves) and evaluated as one suite. A new file
+//!   format goes here; a new kind of body into [`machine`] and [`mbs`].
 //! * [`predict`]: simulated circle tests evaluated like measured ones: the EIJ a model predicts.
 //! * [`ident`]: stiffness reduction factors fitted to measured EIJ, with their uncertainty.
-//! * [`map`]: EIJ over the workspace; `report` (feature `report`): figures and the HTML report.
+//! * [`map`], [`compensation`]: EIJ over the workspace and compensation tables; `report`
+//!   (feature `report`): figures and the HTML report; the `eij` binary's `cli` last.
 //!
 //! Equation numbers (eq. 3–6, section 2.2/2.3) refer to the paper on acceleration correlated
 //! position errors measured with the R-Test that this tool implements and extends.
@@ -67,6 +78,7 @@ pub mod io;
 pub mod machine;
 pub mod map;
 pub mod mbs;
+pub mod measured;
 pub mod predict;
 #[cfg(feature = "report")]
 pub mod report;
@@ -78,5 +90,6 @@ pub use axes::{Axis, Direction, Eij, Plane};
 pub use control::ClosedLoop;
 pub use ident::{IdentError, IdentResult, Identification, Method, Parameter, Settings, TestCase};
 pub use machine::{Machine, MachineError};
+pub use measured::MeasuredError;
 pub use predict::{simulated_eij, CircleTest, PredictError, SimSettings, SolverKind};
 pub use rtest::{evaluate, CircleResult, CircleSeries, EvalOptions, RtestError};

@@ -306,7 +306,7 @@ pub fn read_csv(path: &std::path::Path) -> Result<MapTable, MapError> {
     let mut reader = csv::ReaderBuilder::new().from_reader(text.as_bytes());
     let header: Vec<String> = reader
         .headers()
-        .map_err(|e| bad(1, crate::rtest::layout::csv_message(&e)))?
+        .map_err(|e| bad(1, crate::io::delimited::csv_message(&e)))?
         .iter()
         .map(str::to_string)
         .collect();
@@ -357,7 +357,7 @@ pub fn read_csv(path: &std::path::Path) -> Result<MapTable, MapError> {
         }
         let rec = rec.map_err(|e| {
             let at = e.position().map_or(line, |p| p.line() as usize);
-            bad(at, crate::rtest::layout::csv_message(&e))
+            bad(at, crate::io::delimited::csv_message(&e))
         })?;
         let num = |k: usize| -> Result<f64, MapError> {
             rec.get(k)

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use common::synth::{csv_text, Synth};
 use common::{eij, one_line_error, run, Scratch};
 use eij::axes::Plane;
-use eij::rtest::table;
+use eij::measured::table;
 
 /// Non-zero exit, exactly one line on stderr naming `file` and every one of `needles`, no panic.
 fn assert_error(args: &[&str], file: &Path, needles: &[&str]) {
@@ -557,7 +557,7 @@ fn evaluate_json_is_read_back_by_the_type_that_writes_it() {
     let tests = v["tests"].as_array().unwrap();
     assert_eq!(tests.len(), 18);
     for t in tests {
-        let typed: eij::rtest::json::TestJson = serde_json::from_value(t.clone()).unwrap();
+        let typed: eij::measured::json::TestJson = serde_json::from_value(t.clone()).unwrap();
         assert_eq!(&serde_json::to_value(&typed).unwrap(), t);
         assert_eq!(typed.radius_source, "rtest.toml");
         assert_eq!(

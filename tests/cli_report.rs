@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use common::synth::Synth;
 use common::{one_line_error, run, Scratch};
 use eij::axes::Plane;
-use eij::report::html::fmt_eij;
+use eij::report::labels::fmt_eij;
 use eij::rtest::{evaluate, CircleSeries, EvalOptions};
 
 /// Non-zero exit and one `eij: error:` line naming every needle.

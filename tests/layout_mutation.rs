@@ -9,9 +9,9 @@ mod common;
 
 use common::mutation::{inputs, mutate, one_line, run, Rng};
 use common::{root, Scratch};
-use eij::rtest::conditions::TestConditions;
-use eij::rtest::inputs::expand_tests;
-use eij::rtest::suite::{evaluate_tests, SuiteOptions};
+use eij::measured::conditions::TestConditions;
+use eij::measured::inputs::expand_tests;
+use eij::measured::suite::{evaluate_tests, SuiteOptions};
 use eij::rtest::{evaluate, CircleSeries, EvalOptions};
 
 /// The conditions and the data of a layout seed (split at the line `%%`).

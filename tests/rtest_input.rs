@@ -6,7 +6,7 @@ mod common;
 use common::synth::Synth;
 use common::Scratch;
 use eij::axes::{Axis, Direction, Eij, Plane};
-use eij::rtest::table::{self, EijRow};
+use eij::measured::table::{self, EijRow};
 use eij::rtest::{evaluate, CircleSeries, EvalOptions, Line, RtestError};
 
 fn cols(n: usize) -> (Vec<f64>, [Vec<f64>; 3], [Vec<f64>; 3]) {

@@ -17,9 +17,9 @@ use common::synth::{csv_text, Rng};
 use common::{demo, Scratch};
 use eij::axes::{Axis, Direction, Eij, Plane};
 use eij::control::ClosedLoop;
-use eij::rtest::inputs::expand_tests;
+use eij::measured::inputs::expand_tests;
+use eij::measured::suite::{evaluate_tests, EvaluatedTest, OffsetSource, Suite, SuiteOptions};
 use eij::rtest::iso230::{bidirectional_deviation, path_figures};
-use eij::rtest::suite::{evaluate_tests, EvaluatedTest, OffsetSource, Suite, SuiteOptions};
 use eij::sim::setpoint::Circle;
 use eij::sim::{output, simulate};
 

@@ -5,8 +5,9 @@
 mod common;
 
 use common::mutation::{one_line, run};
-use eij::rtest::conditions::TestConditions;
-use eij::rtest::{evaluate, table, CircleSeries, EvalOptions};
+use eij::measured::conditions::TestConditions;
+use eij::measured::table;
+use eij::rtest::{evaluate, CircleSeries, EvalOptions};
 
 #[test]
 fn rtest_series_mutations() {

@@ -1,7 +1,7 @@
 //! `rtest.toml`: any text gives conditions or a one-line error naming the file.
 #![no_main]
 
-use eij::rtest::conditions::TestConditions;
+use eij::measured::conditions::TestConditions;
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {

@@ -3,7 +3,7 @@
 //! one-line error naming the data file.
 #![no_main]
 
-use eij::rtest::conditions::TestConditions;
+use eij::measured::conditions::TestConditions;
 use eij::rtest::{evaluate, CircleSeries, EvalOptions};
 use libfuzzer_sys::fuzz_target;
 

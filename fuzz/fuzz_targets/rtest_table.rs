@@ -1,7 +1,7 @@
 //! EIJ table CSV: any bytes are read into rows or a one-line error naming the file.
 #![no_main]
 
-use eij::rtest::table;
+use eij::measured::table;
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {

@@ -4,6 +4,7 @@
 
 use eij::ident::IdentError;
 use eij::map::MapError;
+use eij::measured::MeasuredError;
 use eij::predict::PredictError;
 use eij::rtest::RtestError;
 
@@ -13,9 +14,11 @@ fn chain(e: impl std::error::Error + Send + Sync + 'static) -> String {
 }
 
 /// `eij evaluate`: an ambiguous plane can be given with `--plane`.
-pub fn evaluate(e: RtestError) -> anyhow::Error {
+pub fn evaluate(e: MeasuredError) -> anyhow::Error {
     match e {
-        RtestError::AmbiguousPlane { .. } => anyhow::anyhow!("{e}; give --plane"),
+        MeasuredError::Evaluation(RtestError::AmbiguousPlane { .. }) => {
+            anyhow::anyhow!("{e}; give --plane")
+        }
         e => e.into(),
     }
 }

@@ -5,9 +5,10 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use eij::axes::Plane;
-use eij::rtest::inputs::expand_tests;
-use eij::rtest::suite::{self, EvaluatedTest, Suite, SuiteOptions};
-use eij::rtest::{self, table, CircleSeries, EvalOptions, PooledResult};
+use eij::measured::inputs::expand_tests;
+use eij::measured::suite::{self, EvaluatedTest, Suite, SuiteOptions};
+use eij::measured::table;
+use eij::rtest::{self, CircleSeries, EvalOptions, PooledResult};
 
 /// Arguments of `eij evaluate`.
 #[derive(Debug, clap::Args)]
@@ -102,7 +103,7 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<()> {
             plane: args.plane,
             radius_mm,
         };
-        Some(rtest::evaluate_pooled(&refs, &opts).map_err(super::advice::evaluate)?)
+        Some(rtest::evaluate_pooled(&refs, &opts).map_err(|e| super::advice::evaluate(e.into()))?)
     } else {
         None
     };

@@ -1,7 +1,7 @@
 //! `eij evaluate-move FILE.csv --axis J [--json]`: EIJ of the moved axis from a positioning move.
 
 use eij::axes::Axis;
-use eij::rtest::moves::evaluate_move;
+use eij::measured::moves::evaluate_move;
 use std::path::PathBuf;
 
 /// Arguments of `eij evaluate-move`.

@@ -174,7 +174,7 @@ struct Prepared {
     /// How measured data were read (validation data are read alike).
     measured_options: MeasuredOptions,
     /// The clock offsets the evaluation estimated.
-    clocks: Vec<eij::rtest::suite::ClockReport>,
+    clocks: Vec<eij::measured::suite::ClockReport>,
 }
 
 fn prepare(
@@ -335,7 +335,7 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
         .iter()
         .filter_map(|f| {
             f.parent()
-                .map(|d| d.join(eij::rtest::conditions::CONDITIONS_FILE))
+                .map(|d| d.join(eij::measured::conditions::CONDITIONS_FILE))
         })
         .filter(|c| c.is_file())
         .collect();

@@ -434,7 +434,7 @@ pub(super) fn print_validation(v: &Validation, tables: bool) {
 }
 
 /// The clock offsets the evaluation estimated: a summary, with `tables` every clock.
-pub(super) fn print_clocks(clocks: &[eij::rtest::suite::ClockReport], tables: bool) {
+pub(super) fn print_clocks(clocks: &[eij::measured::suite::ClockReport], tables: bool) {
     if clocks.is_empty() {
         return;
     }

@@ -298,8 +298,8 @@ pub struct ClockOffsetReport {
     pub notes: Vec<String>,
 }
 
-impl From<&crate::rtest::suite::ClockReport> for ClockOffsetReport {
-    fn from(c: &crate::rtest::suite::ClockReport) -> Self {
+impl From<&crate::measured::suite::ClockReport> for ClockOffsetReport {
+    fn from(c: &crate::measured::suite::ClockReport) -> Self {
         ClockOffsetReport {
             clock: c.clock.clone(),
             tests: c.tests.clone(),

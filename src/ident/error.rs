@@ -36,6 +36,9 @@ pub enum IdentError {
     /// Reading or evaluating measured data (the message names file and line).
     #[error(transparent)]
     Rtest(#[from] crate::rtest::RtestError),
+    /// Reading measured files (the message names file and line or key).
+    #[error(transparent)]
+    Measured(#[from] crate::measured::MeasuredError),
     /// A settings file that cannot be parsed (the message names file and place).
     #[error(transparent)]
     File(#[from] crate::machine::MachineError),

@@ -3,22 +3,22 @@
 
 pub use super::settings::MeasuredOptions;
 use super::{IdentError, TestCase};
+use crate::measured::conditions::Recording;
+use crate::measured::inputs::{expand_tests, TestInput};
+use crate::measured::suite::{evaluate_tests, ClockReport, SuiteOptions};
+use crate::measured::table;
 use crate::predict::CircleTest;
-use crate::rtest::conditions::Recording;
-use crate::rtest::inputs::{expand_tests, TestInput};
-use crate::rtest::suite::{evaluate_tests, ClockReport, SuiteOptions};
-use crate::rtest::table;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 /// Expands folders (their `*.csv`, sub-folders included, sorted) and keeps files.
 pub fn expand(paths: &[PathBuf]) -> Result<Vec<PathBuf>, IdentError> {
-    Ok(crate::rtest::inputs::expand_inputs(paths)?)
+    Ok(crate::measured::inputs::expand_inputs(paths)?)
 }
 
 /// Reads every path into test cases: R-Test series (single files and two-system recordings
 /// with their `rtest.toml` conditions) are evaluated as `eij evaluate` does
-/// ([`crate::rtest::suite::evaluate_tests`], so that the measured EIJ are evaluate's), the set
+/// ([`crate::measured::suite::evaluate_tests`], so that the measured EIJ are evaluate's), the set
 /// radius from `rtest.toml`, else `opts.radius_mm`; EIJ tables are grouped by plane, direction
 /// and acceleration. Folders are read with their sub-folders.
 pub fn load(paths: &[PathBuf], opts: &MeasuredOptions) -> Result<Vec<TestCase>, IdentError> {

@@ -5,6 +5,7 @@
 use std::path::{Path, PathBuf};
 
 mod commit;
+pub mod delimited;
 mod journal;
 pub mod read;
 

@@ -1,18 +1,18 @@
 //! The circle tests of a report grouped as metrologists compare them: the cw and the ccw test
 //! of one plane, circle centre, radius and acceleration together (the pairs of
-//! [`crate::rtest::suite::Suite::bidirectional`], whose G(b) they carry), a test without a
+//! [`crate::measured::suite::Suite::bidirectional`], whose G(b) they carry), a test without a
 //! partner alone. Per group a polar plot of both paths ([`super::polar`]), beside it the ISO
 //! 230-4 figures of every path exactly as `eij evaluate` computes them, and the out-of-plane
 //! deviation over the phase.
 
 use std::fmt::Write as _;
 
-use super::html::{feed_mm_min, folder_and_name, position_label};
+use super::labels::{feed_mm_min, folder_and_name, position_label};
 use super::page::{escape, Figure, Page};
 use super::polar::{self, PolarFigure, PolarPath, PolarScale};
 use super::{short, ReportError};
+use crate::measured::suite::{Bidirectional, EvaluatedTest, Suite};
 use crate::rtest::iso230::PathFigures;
-use crate::rtest::suite::{Bidirectional, EvaluatedTest, Suite};
 
 /// One group: its tests (indices into the suite, cw before ccw) and their G(b) where they pair.
 pub struct CircleGroup<'a> {

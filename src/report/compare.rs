@@ -8,8 +8,8 @@
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
-use super::html::fmt_eij;
 use super::ident_plot::test_label;
+use super::labels::fmt_eij;
 use super::page::{escape, Page};
 use super::verdict::{fit_quality, headline, status_html, LoadedIdent};
 use crate::axes::Eij;

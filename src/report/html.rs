@@ -12,6 +12,7 @@ use std::collections::BTreeSet;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+use super::labels::{feed_mm_min, fmt_eij, folder_and_name, folders_of, position_label};
 pub use super::page::Figure;
 use super::page::{anchor, escape, Page};
 use super::verdict::{self, LoadedIdent};
@@ -20,8 +21,7 @@ use super::{
 };
 use crate::axes::Plane;
 use crate::ident::report::IdentReport;
-use crate::rtest::suite::{EvaluatedTest, Suite};
-use crate::rtest::CircleResult;
+use crate::measured::suite::{EvaluatedTest, Suite};
 
 /// The report page's file name.
 pub const REPORT_FILE: &str = "report.html";
@@ -41,57 +41,9 @@ pub struct ReportRequest {
     pub out_dir: PathBuf,
 }
 
-/// Expands files and folders (see [`crate::rtest::inputs::expand_inputs`]).
+/// Expands files and folders (see [`crate::measured::inputs::expand_inputs`]).
 pub fn expand_measured(paths: &[PathBuf]) -> Result<Vec<PathBuf>, ReportError> {
-    Ok(crate::rtest::inputs::expand_inputs(paths)?)
-}
-
-/// `folder/name` of a path: the name alone is ambiguous when several folders (test positions)
-/// hold files of the same name.
-pub(crate) fn folder_and_name(path: &Path) -> String {
-    let name = path
-        .file_name()
-        .map(|f| f.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    match path.parent().and_then(|p| p.file_name()) {
-        Some(dir) => format!("{}/{name}", dir.to_string_lossy()),
-        None => name,
-    }
-}
-
-/// The folders of `files` with the number of files in each, in order of appearance:
-/// `measurements/demo-vmc/pos-a (18 files)`.
-pub(crate) fn folders_of<'a>(files: impl Iterator<Item = &'a Path>) -> Vec<String> {
-    let mut folders: Vec<(String, usize)> = Vec::new();
-    for f in files {
-        let dir = f
-            .parent()
-            .map(|d| d.display().to_string())
-            .filter(|d| !d.is_empty())
-            .unwrap_or_else(|| ".".into());
-        match folders.iter_mut().find(|(d, _)| *d == dir) {
-            Some((_, n)) => *n += 1,
-            None => folders.push((dir, 1)),
-        }
-    }
-    folders
-        .into_iter()
-        .map(|(d, n)| format!("{d} ({n} file{})", if n == 1 { "" } else { "s" }))
-        .collect()
-}
-
-/// An EIJ value as written in the tables (4 decimals).
-pub fn fmt_eij(v: f64) -> String {
-    if v.is_finite() {
-        format!("{v:.4}")
-    } else {
-        "–".into()
-    }
-}
-
-/// Axis positions as written in labels: `150,-100,0`.
-pub(crate) fn position_label(p: &[f64]) -> String {
-    p.iter().map(|v| short(*v, 1)).collect::<Vec<_>>().join(",")
+    Ok(crate::measured::inputs::expand_inputs(paths)?)
 }
 
 /// The name of a test with its circle centre: `pos-a/xy_ccw_2.csv @ 150,-100,0 mm`.
@@ -167,8 +119,8 @@ pub fn generate(req: &ReportRequest) -> Result<PathBuf, ReportError> {
     check_out_dir(req)?;
     let date = crate::ident::report::utc_timestamp()?;
     let files = expand_measured(&req.measured)?;
-    let tests = crate::rtest::inputs::expand_tests(&req.measured)?;
-    let suite = crate::rtest::suite::evaluate_tests(&tests, &Default::default())?;
+    let tests = crate::measured::inputs::expand_tests(&req.measured)?;
+    let suite = crate::measured::suite::evaluate_tests(&tests, &Default::default())?;
     let groups = circle_group::groups(&suite)?;
     let scale = circle_group::page_scale(&groups);
     let circle_figures = groups
@@ -398,11 +350,6 @@ fn header_html(
     h
 }
 
-/// The path speed of a circle test, mm/min: 2π·r·f·60.
-pub(crate) fn feed_mm_min(r: &CircleResult) -> f64 {
-    std::f64::consts::TAU * r.radius_mm * r.freq_hz * 60.0
-}
-
 /// The verdict first: each identification's, then the circle evaluation's warnings.
 fn verdict_section(page: &mut Page, idents: &[LoadedIdent], suite: &Suite) {
     page.heading(2, "verdict", "Verdict");
@@ -453,7 +400,7 @@ fn move_vs_circle_html(
         "<table>\n<tr><th>move</th><th>EIJ</th><th>move</th><th>± std err</th><th>circles (n)</th></tr>"
     );
     for (path, (data, _)) in paths.iter().zip(moves) {
-        let Ok(m) = crate::rtest::moves::evaluate_move(path, data.axis) else {
+        let Ok(m) = crate::measured::moves::evaluate_move(path, data.axis) else {
             let _ = writeln!(
                 h,
                 "<tr><td>{}</td><td colspan=\"4\">no set acceleration to evaluate</td></tr>",

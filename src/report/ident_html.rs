@@ -4,8 +4,8 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::html::{fmt_eij, folder_and_name};
 use super::ident_plot::test_label;
+use super::labels::{fmt_eij, folder_and_name};
 use super::page::{anchor, escape, Figure, Page};
 use super::verdict::LoadedIdent;
 use super::{identification_svg, short, ReportError};
@@ -32,7 +32,7 @@ pub fn details(page: &mut Page, id: &LoadedIdent, fig: &Figure) {
     );
     let mut h = String::new();
     if !rep.measured_inputs.is_empty() {
-        let folders = super::html::folders_of(rep.measured_inputs.iter().map(Path::new));
+        let folders = super::labels::folders_of(rep.measured_inputs.iter().map(Path::new));
         let _ = writeln!(
             h,
             "<p class=\"note\">Measured inputs: {} file(s) in {}.</p>",

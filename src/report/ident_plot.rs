@@ -15,7 +15,7 @@ use crate::ident::report::{IdentReport, TestReport};
 pub fn test_label(t: &TestReport) -> String {
     let base = format!("{} {} {}", t.plane, t.direction, short(t.accel_m_s2, 1));
     match &t.position_mm {
-        Some(p) => format!("{base} @ {}", super::html::position_label(p)),
+        Some(p) => format!("{base} @ {}", super::labels::position_label(p)),
         None => base,
     }
 }

@@ -7,7 +7,7 @@
 //! move CSV / sim::Run ─► MoveData ─► move_svg      (paper Fig. 9: position, acceleration, cross-talk)
 //! identify report JSON ─► identification_svg        (measured vs simulated EIJ, cost history)
 //! map::eij_map points ─► map_svg                   (EIJ over the workspace)
-//! cw/ccw pairs (rtest::suite) ─► circle_group ─► polar_svg (ISO 230-4 circle plot, µm rings)
+//! cw/ccw pairs (measured::suite) ─► circle_group ─► polar_svg (ISO 230-4 circle plot, µm rings)
 //!                                             └► polar::out_of_plane_svg (cw and ccw over φ)
 //! identify reports ─► verdict (standing, χ², warnings), compare (side by side)
 //! all of it ─► html::generate ─► DIR/report.html (figures inline, page::Page)
@@ -21,7 +21,7 @@
 //! EIJ maps over the workspace ([`map_svg`], from `eij map`) enter a report as further
 //! [`html::Figure`]s through [`html::ReportRequest::extra_figures`].
 
-use crate::rtest::conditions::TestConditions;
+use crate::measured::conditions::TestConditions;
 use std::path::Path;
 
 pub mod circle;
@@ -30,6 +30,7 @@ pub mod compare;
 pub mod html;
 pub mod ident_html;
 pub mod ident_plot;
+pub mod labels;
 pub mod map_plot;
 pub mod move_plot;
 pub mod page;
@@ -48,7 +49,7 @@ pub use stiffness::stiffness_html;
 /// Reads an input file of the report (the R-Test reader's, telling a missing file and a folder
 /// apart from other failures).
 pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>, ReportError> {
-    Ok(crate::rtest::series::read_file(path)?)
+    Ok(crate::measured::series::read_file(path)?)
 }
 
 /// Errors of the figures and the report; every message is one line naming the file or key.
@@ -57,6 +58,9 @@ pub enum ReportError {
     /// Reading or evaluating a circle test failed.
     #[error(transparent)]
     Rtest(#[from] crate::rtest::RtestError),
+    /// Reading a measured file failed (the message names file and line or key).
+    #[error(transparent)]
+    Measured(#[from] crate::measured::MeasuredError),
     /// A file holds something unusable (missing column, bad number, ...).
     #[error("{source_name}: {message}")]
     BadInput {

@@ -16,8 +16,8 @@ use plotters::prelude::*;
 use super::svg::{self, Entry, Mark};
 use super::{short, ReportError};
 use crate::axes::Direction;
+use crate::measured::suite::EvaluatedTest;
 use crate::rtest::normalise::circle_centre;
-use crate::rtest::suite::EvaluatedTest;
 use crate::rtest::{CircleSeries, EvalOptions};
 
 /// Colour of clockwise paths.

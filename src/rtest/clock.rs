@@ -20,8 +20,7 @@ use argmin::core::{CostFunction, Executor};
 use argmin::solver::brent::BrentOpt;
 
 use super::error::{Location, RtestError};
-use super::layout::{read_table, ColumnMap};
-use super::series::{read_file, CircleSeries, EXT_COLUMNS, INT_COLUMNS, TIME_COLUMN};
+use super::series::CircleSeries;
 
 /// Least overlap of the two records, as a share of the shorter one.
 pub const MIN_OVERLAP: f64 = 0.5;
@@ -53,32 +52,19 @@ impl Recording {
         Ok(r)
     }
 
-    /// Reads the internal file of a two-system test: `t_s` and `{x,y,z}_int_mm`.
-    pub fn read_internal(path: &std::path::Path, map: &ColumnMap) -> Result<Self, RtestError> {
-        Self::read(path, map, &INT_COLUMNS)
-    }
-
-    /// Reads the external file of a two-system test: `t_s` and `{x,y,z}_ext_mm`.
-    pub fn read_external(path: &std::path::Path, map: &ColumnMap) -> Result<Self, RtestError> {
-        Self::read(path, map, &EXT_COLUMNS)
-    }
-
-    fn read(
-        path: &std::path::Path,
-        map: &ColumnMap,
-        columns: &[&str; 3],
+    /// A recording read from a file (`lines`: the file line of every row), validated as
+    /// [`Recording::new`]; the readers are in [`crate::measured`].
+    pub fn with_lines(
+        source: String,
+        t_s: Vec<f64>,
+        mm: [Vec<f64>; 3],
+        lines: Vec<u64>,
     ) -> Result<Self, RtestError> {
-        let name = path.display().to_string();
-        let bytes = read_file(path)?;
-        let wanted = [TIME_COLUMN, columns[0], columns[1], columns[2]];
-        let table = read_table(&name, &bytes, &wanted, map)?;
-        let mut cols = table.columns.into_iter();
-        let mut next = || cols.next().unwrap_or_default();
         let r = Recording {
-            source: name,
-            t_s: next(),
-            mm: [next(), next(), next()],
-            lines: Some(table.lines),
+            source,
+            t_s,
+            mm,
+            lines: Some(lines),
         };
         r.check()?;
         Ok(r)
@@ -89,7 +75,7 @@ impl Recording {
             Some(l) => Location::file_line(&self.source, l[i]),
             None => Location {
                 source: self.source.clone(),
-                line: Some(super::Line::Row(i + 1)),
+                line: Some(super::error::Line::Row(i + 1)),
             },
         }
     }

@@ -1,26 +1,9 @@
 //! Errors of the R-Test evaluation: every message is one line naming the source (file or
-//! in-memory series), the line or row where one applies, and what is wrong.
+//! in-memory series), the line or row where one applies, and what is wrong. Reading files has
+//! its own errors ([`crate::measured::MeasuredError`]), which carry these where a file's
+//! series fails the evaluation.
 
 use std::fmt;
-
-/// File text as it may appear inside a one-line message: control characters (line ends in a
-/// quoted cell, NUL, …) escaped, and long text cut after 40 characters.
-pub fn quote_cell(text: &str) -> String {
-    const MAX_CHARS: usize = 40;
-    let mut out = String::new();
-    for (i, c) in text.chars().enumerate() {
-        if i == MAX_CHARS {
-            out.push('…');
-            break;
-        }
-        if c.is_control() {
-            out.extend(c.escape_default());
-        } else {
-            out.push(c);
-        }
-    }
-    out
-}
 
 /// Where in a source a problem was found.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -68,81 +51,9 @@ impl fmt::Display for Location {
     }
 }
 
-/// Everything that can go wrong reading or evaluating circle tests and EIJ tables.
+/// Everything that can go wrong evaluating a circle test (in-memory or read from a file).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RtestError {
-    /// The file could not be opened or read.
-    #[error("{path}: cannot read: {message}")]
-    Io {
-        /// The path given.
-        path: String,
-        /// What the operating system said (or "file not found").
-        message: String,
-    },
-    /// The path names a folder.
-    #[error("{path}: is a folder, not a file")]
-    NotAFile {
-        /// The path given.
-        path: String,
-    },
-    /// No header line at all.
-    #[error("{at}: empty file (expected a header line with {expected})")]
-    Empty {
-        /// The file.
-        at: Location,
-        /// The required columns.
-        expected: String,
-    },
-    /// The file is not well-formed CSV (e.g. a row with the wrong number of fields).
-    #[error("{at}: {message}")]
-    Csv {
-        /// Where.
-        at: Location,
-        /// What the CSV reader found.
-        message: String,
-    },
-    /// Required columns are missing from the header.
-    #[error(
-        "{at}: missing column(s) {}{}",
-        columns.join(", "),
-        header.as_ref().map_or(String::new(), |h| format!(" (header read: {h})"))
-    )]
-    MissingColumns {
-        /// The header line.
-        at: Location,
-        /// The missing names.
-        columns: Vec<String>,
-        /// The header as read, with the separator recognised, where that helps.
-        header: Option<String>,
-    },
-    /// A required column appears twice.
-    #[error("{at}: duplicate column '{column}'")]
-    DuplicateColumn {
-        /// The header line.
-        at: Location,
-        /// The repeated name.
-        column: String,
-    },
-    /// A column that this reader does not know (EIJ tables only, to catch typos).
-    #[error("{at}: unknown column '{column}' (expected {expected})")]
-    UnknownColumn {
-        /// The header line.
-        at: Location,
-        /// The unknown name.
-        column: String,
-        /// The known names.
-        expected: String,
-    },
-    /// A cell that is not a number.
-    #[error("{at}: column {column}: '{value}' is not a number")]
-    NotANumber {
-        /// Where.
-        at: Location,
-        /// The column.
-        column: String,
-        /// The cell text.
-        value: String,
-    },
     /// A cell that is NaN or infinite.
     #[error("{at}: column {column}: '{value}' is not a finite number")]
     NotFinite {
@@ -153,22 +64,12 @@ pub enum RtestError {
         /// The cell text.
         value: String,
     },
-    /// An invalid `rtest.toml` (test conditions of a folder).
-    #[error("{file}: {key}: {message}")]
-    Conditions {
-        /// The conditions file.
-        file: String,
-        /// The key.
-        key: String,
-        /// What is wrong.
-        message: String,
-    },
-    /// A cell with a value outside its domain (EIJ tables: plane, direction, parameter, ...).
+    /// An option outside its domain (the set radius).
     #[error("{at}: column {column}: {message}")]
     BadValue {
-        /// Where.
+        /// The series.
         at: Location,
-        /// The column.
+        /// The option.
         column: String,
         /// What is wrong.
         message: String,
@@ -296,19 +197,4 @@ pub enum RtestError {
         /// What is wrong.
         detail: String,
     },
-    /// Writing an output file failed.
-    #[error(transparent)]
-    Write(#[from] WriteFailure),
-}
-
-/// A failed output write (wraps [`crate::io::WriteError`], kept as text so that
-/// [`RtestError`] stays `Clone + PartialEq`).
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("{0}")]
-pub struct WriteFailure(pub String);
-
-impl From<crate::io::WriteError> for RtestError {
-    fn from(e: crate::io::WriteError) -> Self {
-        RtestError::Write(WriteFailure(e.to_string()))
-    }
 }

@@ -1,4 +1,5 @@
-//! R-Test circle-test evaluation (paper section 2.3): read, normalise, fit EIJ.
+//! R-Test circle-test evaluation (paper section 2.3): normalise, fit EIJ. The series come from
+//! files ([`crate::measured`]) or from the simulator ([`crate::sim`]).
 //!
 //! ```text
 //! CSV / simulator ─► CircleSeries ─► normalise (eq. 5–6) ─► joint fit (primary)
@@ -10,7 +11,7 @@
 //! ```no_run
 //! use eij::rtest::{evaluate, evaluate_pooled, CircleSeries, EvalOptions};
 //!
-//! # fn main() -> Result<(), eij::rtest::RtestError> {
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
 //! let opts = EvalOptions { radius_mm: Some(2.0), ..Default::default() };
 //! let slow = CircleSeries::read_csv("measurements/zx_ccw_2.csv")?;
 //! let fast = CircleSeries::read_csv("measurements/zx_ccw_10.csv")?;
@@ -38,22 +39,16 @@ use crate::axes::{Axis, Direction, Eij, Plane};
 pub mod checks;
 pub mod clock;
 pub mod clock_fit;
-pub mod conditions;
 pub mod diagnosis;
 pub mod error;
 pub mod fit;
 pub mod harmonic;
-pub mod inputs;
 pub mod iso230;
-pub mod json;
-pub mod layout;
 pub mod lstsq;
 pub mod moves;
 pub mod normalise;
 pub mod pooled;
 pub mod series;
-pub mod suite;
-pub mod table;
 
 pub use error::{Line, Location, RtestError};
 pub use pooled::{evaluate_pooled, PooledResult};
@@ -231,14 +226,4 @@ pub fn evaluate(series: &CircleSeries, opts: &EvalOptions) -> Result<CircleResul
 /// A parameter map as a JSON object keyed by the parameter names (`EZZ`, ...).
 pub fn eij_json(map: &BTreeMap<Eij, f64>) -> Value {
     Value::Object(map.iter().map(|(k, v)| (k.name(), json!(v))).collect())
-}
-
-impl CircleResult {
-    /// The CONTRACT.md JSON object of one test (`file`, `plane`, `direction`, `radius_mm`,
-    /// `accel_m_s2`, `freq_hz`, `eij_um_s2_per_m`, `std_err_um_s2_per_m`, `rms_residual_um`)
-    /// plus `measured_radius_mm`, `offsets_um`, `revolutions`, `samples_used`, `plane_fit`,
-    /// `ellipse_fit` (null when it failed) and `warnings`.
-    pub fn to_json(&self) -> Value {
-        serde_json::to_value(json::CircleJson::from(self)).unwrap_or(Value::Null)
-    }
 }

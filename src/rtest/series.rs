@@ -1,9 +1,8 @@
-//! Circle-test time series (CONTRACT.md columns): strict CSV reader and in-memory constructor.
+//! Circle-test time series (CONTRACT.md columns), validated on construction. Files are read
+//! into it by [`crate::measured`] (`CircleSeries::read_csv` and its variants), the simulator
+//! hands its runs over through [`CircleSeries::new`].
 
-use std::path::Path;
-
-use super::error::{quote_cell, Line, Location, RtestError};
-use super::layout::{read_table, ColumnMap, CONTRACT_COLUMNS};
+use super::error::{Line, Location, RtestError};
 use crate::axes::Axis;
 
 /// Column names of the internal readings, x, y, z.
@@ -12,6 +11,10 @@ pub const INT_COLUMNS: [&str; 3] = ["x_int_mm", "y_int_mm", "z_int_mm"];
 pub const EXT_COLUMNS: [&str; 3] = ["x_ext_mm", "y_ext_mm", "z_ext_mm"];
 /// Column name of the time.
 pub const TIME_COLUMN: &str = "t_s";
+/// The contract columns of an R-Test series: time, internal x, y, z, external x, y, z.
+pub const CONTRACT_COLUMNS: [&str; 7] = [
+    "t_s", "x_int_mm", "y_int_mm", "z_int_mm", "x_ext_mm", "y_ext_mm", "z_ext_mm",
+];
 
 /// One circle test: time, internal readings (the axes' own measuring systems) and external
 /// readings (R-Test sphere centre relative to the nest), all relative to the circle centre.
@@ -90,55 +93,9 @@ impl CircleSeries {
         Ok(series)
     }
 
-    /// Reads a circle-test CSV (CONTRACT.md): required columns `t_s`, `{x,y,z}_int_mm`,
-    /// `{x,y,z}_ext_mm` in any order; other columns ignored. The dialect (separator, decimal
-    /// comma, comment lines, a metadata block before the header) is recognised, see
-    /// [`super::layout`].
-    pub fn read_csv(path: impl AsRef<Path>) -> Result<Self, RtestError> {
-        Self::read_csv_with(path, &ColumnMap::default())
-    }
-
-    /// As [`CircleSeries::read_csv`], the columns named and scaled as `map` says (a folder's
-    /// `rtest.toml` `[columns]`).
-    pub fn read_csv_with(path: impl AsRef<Path>, map: &ColumnMap) -> Result<Self, RtestError> {
-        let path = path.as_ref();
-        let bytes = read_file(path)?;
-        Self::from_csv_bytes_with(&path.display().to_string(), &bytes, map)
-    }
-
-    /// As [`CircleSeries::read_csv`] on the bytes of a file already read (or generated);
-    /// `name` stands for the file in error messages. A leading UTF-8 byte-order mark is dropped.
-    pub fn from_csv_bytes(name: &str, bytes: &[u8]) -> Result<Self, RtestError> {
-        Self::from_csv_bytes_with(name, bytes, &ColumnMap::default())
-    }
-
-    /// As [`CircleSeries::from_csv_bytes`] with a column map.
-    pub fn from_csv_bytes_with(
-        name: &str,
-        bytes: &[u8],
-        map: &ColumnMap,
-    ) -> Result<Self, RtestError> {
-        let table = read_table(name, bytes, &CONTRACT_COLUMNS, map)?;
-        let mut cols = table.columns.into_iter();
-        let mut next = || cols.next().unwrap_or_default();
-        let t_s = next();
-        let int_mm = [next(), next(), next()];
-        let ext_mm = [next(), next(), next()];
-        let series = CircleSeries {
-            source: name.to_string(),
-            t_s,
-            int_mm,
-            ext_mm,
-            lines: Some(table.lines),
-            names: mapped_names(&table.names),
-        };
-        series.check_rows_and_time()?;
-        Ok(series)
-    }
-
     /// Builds a series from columns already read from files (`lines`: the file line of every
     /// row, `names`: the files' names of the seven contract columns, where they differ).
-    pub(crate) fn from_parts(
+    pub fn from_parts(
         source: String,
         t_s: Vec<f64>,
         int_mm: [Vec<f64>; 3],
@@ -239,79 +196,4 @@ impl CircleSeries {
             line: Some(line),
         }
     }
-}
-
-/// The index of each `wanted` column in `header` (`usize::MAX` when absent); a wanted column
-/// given twice is an error, any other column goes to `other` (to be ignored or refused).
-pub(crate) fn column_indices<const N: usize>(
-    header: &csv::StringRecord,
-    wanted: &[&str; N],
-    at: &Location,
-    mut other: impl FnMut(&str) -> Result<(), RtestError>,
-) -> Result<[usize; N], RtestError> {
-    let mut index = [usize::MAX; N];
-    for (i, cell) in header.iter().enumerate() {
-        match wanted.iter().position(|w| *w == cell) {
-            Some(k) if index[k] != usize::MAX => {
-                return Err(RtestError::DuplicateColumn {
-                    at: at.clone(),
-                    column: quote_cell(cell),
-                })
-            }
-            Some(k) => index[k] = i,
-            None => other(cell)?,
-        }
-    }
-    Ok(index)
-}
-
-/// Fails naming every one of `names` whose `index` is absent.
-pub(crate) fn require_columns(
-    index: &[usize],
-    names: &[&str],
-    at: &Location,
-) -> Result<(), RtestError> {
-    let missing: Vec<String> = names
-        .iter()
-        .zip(index)
-        .filter(|(_, i)| **i == usize::MAX)
-        .map(|(n, _)| n.to_string())
-        .collect();
-    if missing.is_empty() {
-        Ok(())
-    } else {
-        Err(RtestError::MissingColumns {
-            at: at.clone(),
-            columns: missing,
-            header: None,
-        })
-    }
-}
-
-/// The file's names where any differs from the contract's.
-fn mapped_names(names: &[String]) -> Option<Box<[String; 7]>> {
-    let differ = names
-        .iter()
-        .zip(CONTRACT_COLUMNS)
-        .any(|(n, c)| !n.eq_ignore_ascii_case(c));
-    let names: [String; 7] = names.to_vec().try_into().ok()?;
-    differ.then(|| Box::new(names))
-}
-
-/// Reads a whole measured file (at most [`crate::io::read::MAX_SERIES_BYTES`]), telling "not
-/// found" and "is a folder" apart from other failures.
-pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>, RtestError> {
-    read_bounded(path, crate::io::read::MAX_SERIES_BYTES)
-}
-
-/// Reads a whole input file of at most `max_bytes` bytes ([`crate::io::read_input`]).
-pub(crate) fn read_bounded(path: &Path, max_bytes: u64) -> Result<Vec<u8>, RtestError> {
-    let name = path.display().to_string();
-    crate::io::read_input(path, max_bytes).map_err(|e| match e {
-        crate::io::ReadError::IsAFolder => RtestError::NotAFile { path: name },
-        e => RtestError::Io {
-            path: name,
-            message: e.to_string(),
-        },
-    })
 }

@@ -3,10 +3,11 @@
 //! and [`crate::rtest::clock_fit`]).
 
 use super::{group_key, series_at, Data, Prepared, SuiteOptions};
+use crate::measured::inputs::TestInput;
+use crate::measured::MeasuredError;
 use crate::rtest::clock::{self, Recording as Record};
 use crate::rtest::clock_fit::{fit_offset, OffsetFit, OffsetTest};
 use crate::rtest::error::{Location, RtestError};
-use crate::rtest::inputs::TestInput;
 use crate::rtest::normalise::{normalise, Normalised};
 use crate::rtest::{CircleSeries, EvalOptions};
 
@@ -113,7 +114,7 @@ pub(super) fn align_clock(
     inputs: &[TestInput],
     prepared: &[Prepared],
     offsets: &mut [Option<TimeOffset>],
-) -> Result<Vec<ClockReport>, RtestError> {
+) -> Result<Vec<ClockReport>, MeasuredError> {
     let mut aligned = Vec::new();
     for &i in members {
         let Data::Split { internal, external } = &prepared[i].data else {
@@ -136,7 +137,8 @@ pub(super) fn align_clock(
                     a.offset_s * 1e3,
                     a.next_best_rms_um
                 ),
-            });
+            }
+            .into());
         }
         aligned.push((i, a.offset_s));
     }
@@ -153,9 +155,9 @@ pub(super) fn align_clock(
     let fit = if one_clock {
         let norms = aligned
             .iter()
-            .map(|&(i, _)| {
+            .map(|&(i, _)| -> Result<_, MeasuredError> {
                 let s = series_at(&inputs[i], &prepared[i].data, Some(base))?;
-                normalise(&s, &prepared[i].opts)
+                Ok(normalise(&s, &prepared[i].opts)?)
             })
             .collect::<Result<Vec<_>, _>>()?;
         joint_offset(clock, &aligned, inputs, &norms)?
@@ -227,7 +229,7 @@ fn joint_offset(
     members: &[(usize, f64)],
     inputs: &[TestInput],
     norms: &[Normalised],
-) -> Result<Option<OffsetFit>, RtestError> {
+) -> Result<Option<OffsetFit>, MeasuredError> {
     let keys: Vec<String> = members
         .iter()
         .zip(norms)
@@ -244,6 +246,7 @@ fn joint_offset(
             detail: "the joint clock-offset fit has no unique solution".into(),
         })
         .map(Some)
+        .map_err(MeasuredError::from)
 }
 
 /// Single-file tests of one clock (folder): the lag of the external readings, fitted jointly
@@ -256,7 +259,7 @@ pub(super) fn lag_of_clock(
     prepared: &[Prepared],
     opts: &SuiteOptions,
     offsets: &mut [Option<TimeOffset>],
-) -> Result<Vec<ClockReport>, RtestError> {
+) -> Result<Vec<ClockReport>, MeasuredError> {
     let mut free = Vec::new();
     for &i in members {
         match inputs[i].time_offset_ms {

@@ -5,12 +5,12 @@
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
-use super::conditions::{folder_of, Recording, TestConditions, TestEntry};
+use super::conditions::{folder_of, Recording, TestConditions, TestEntry, MAX_TESTS};
+use super::error::MeasuredError;
 use super::layout::ColumnMap;
-use super::series::CircleSeries;
-use super::RtestError;
 use crate::axes::{Direction, Plane};
 use crate::io::FileId;
+use crate::rtest::CircleSeries;
 
 /// One circle test to read and evaluate, with everything known about its conditions.
 #[derive(Debug, Clone, PartialEq)]
@@ -75,11 +75,11 @@ impl TestInput {
     }
 
     /// Reads a single-file test (column map applied). Two-system tests are read and brought
-    /// onto one time base by [`super::clock`].
-    pub fn read_single(&self) -> Result<CircleSeries, RtestError> {
+    /// onto one time base by [`crate::rtest::clock`].
+    pub fn read_single(&self) -> Result<CircleSeries, MeasuredError> {
         match &self.recording {
             Recording::Single(f) => CircleSeries::read_csv_with(f, &self.columns),
-            Recording::Split { .. } => Err(RtestError::Io {
+            Recording::Split { .. } => Err(MeasuredError::Io {
                 path: self.name(),
                 message: "a test recorded by two systems is read through rtest::clock".into(),
             }),
@@ -134,7 +134,7 @@ fn entry_files(e: &TestEntry) -> Vec<(&'static str, &Path)> {
 
 /// Checks that every file of the folder's entries exists and that no two entries name the
 /// same file (by identity: `a.csv`, `./a.csv` and a link to it are one file).
-fn check_entries(cond: &TestConditions) -> Result<(), RtestError> {
+fn check_entries(cond: &TestConditions) -> Result<(), MeasuredError> {
     let file = cond
         .file
         .as_ref()
@@ -143,7 +143,7 @@ fn check_entries(cond: &TestConditions) -> Result<(), RtestError> {
     for e in &cond.tests {
         for (key, path) in entry_files(e) {
             let at = format!("[[test]] #{} {key}", e.number);
-            let bad = |message: String| RtestError::Conditions {
+            let bad = |message: String| MeasuredError::Conditions {
                 file: file.clone(),
                 key: at.clone(),
                 message,
@@ -166,16 +166,13 @@ fn check_entries(cond: &TestConditions) -> Result<(), RtestError> {
     Ok(())
 }
 
-/// Most tests one command reads (files named, found in folders and in `[[test]]` tables).
-pub const MAX_TESTS: usize = 10_000;
-
 /// The tests of a folder (its entries and the CSV files no entry names) and, recursively, of
 /// its sub-folders, in path order. `ancestors` are the folders above it (by identity): a
 /// folder inside itself (a symbolic-link loop) is an error, not a copy of its data.
-fn folder_tests(dir: &Path, ancestors: &mut Vec<FileId>) -> Result<Vec<TestInput>, RtestError> {
+fn folder_tests(dir: &Path, ancestors: &mut Vec<FileId>) -> Result<Vec<TestInput>, MeasuredError> {
     if let Some(id) = FileId::of(dir) {
         if ancestors.contains(&id) {
-            return Err(RtestError::Io {
+            return Err(MeasuredError::Io {
                 path: dir.display().to_string(),
                 message: "the folder lies inside itself (a symbolic-link loop)".into(),
             });
@@ -183,7 +180,7 @@ fn folder_tests(dir: &Path, ancestors: &mut Vec<FileId>) -> Result<Vec<TestInput
         ancestors.push(id);
     }
     let mut paths: Vec<PathBuf> = std::fs::read_dir(dir)
-        .map_err(|e| RtestError::Io {
+        .map_err(|e| MeasuredError::Io {
             path: dir.display().to_string(),
             message: format!("cannot read folder: {e}"),
         })?
@@ -225,8 +222,8 @@ fn folder_tests(dir: &Path, ancestors: &mut Vec<FileId>) -> Result<Vec<TestInput
     Ok(items.into_iter().flat_map(|(_, t)| t).collect())
 }
 
-fn too_many(path: &Path) -> RtestError {
-    RtestError::Io {
+fn too_many(path: &Path) -> MeasuredError {
+    MeasuredError::Io {
         path: path.display().to_string(),
         message: format!("more than {MAX_TESTS} tests"),
     }
@@ -235,7 +232,7 @@ fn too_many(path: &Path) -> RtestError {
 /// The test a file given on its own belongs to: its `[[test]]` entry (a two-system test when
 /// the file is its internal or external file), else a single-file test with the folder's
 /// conditions.
-fn file_test(file: &Path) -> Result<TestInput, RtestError> {
+fn file_test(file: &Path) -> Result<TestInput, MeasuredError> {
     let dir = folder_of(file);
     let cond = TestConditions::of_folder(&dir)?;
     let same = |p: &Path| {
@@ -268,13 +265,13 @@ fn file_test(file: &Path) -> Result<TestInput, RtestError> {
 /// that no entry names, and those of its sub-folders, in path order. A test named twice (both
 /// files of a two-system test given) is kept once. A missing path, a folder without tests or
 /// an entry naming a missing file is an error.
-pub fn expand_tests(paths: &[PathBuf]) -> Result<Vec<TestInput>, RtestError> {
+pub fn expand_tests(paths: &[PathBuf]) -> Result<Vec<TestInput>, MeasuredError> {
     let mut tests: Vec<TestInput> = Vec::new();
     for p in paths {
         if p.is_dir() {
             let inside = folder_tests(p, &mut Vec::new())?;
             if inside.is_empty() {
-                return Err(RtestError::Io {
+                return Err(MeasuredError::Io {
                     path: p.display().to_string(),
                     message: "folder holds no .csv files".into(),
                 });
@@ -289,7 +286,7 @@ pub fn expand_tests(paths: &[PathBuf]) -> Result<Vec<TestInput>, RtestError> {
                 tests.push(t);
             }
         } else {
-            return Err(RtestError::Io {
+            return Err(MeasuredError::Io {
                 path: p.display().to_string(),
                 message: "file not found".into(),
             });
@@ -304,7 +301,7 @@ pub fn expand_tests(paths: &[PathBuf]) -> Result<Vec<TestInput>, RtestError> {
 
 /// Refuses a measured file reached twice (named twice, in two folders given, through a link):
 /// it would count twice and make the standard errors too small.
-fn once_each(tests: &[TestInput]) -> Result<(), RtestError> {
+fn once_each(tests: &[TestInput]) -> Result<(), MeasuredError> {
     let mut seen: Vec<(FileId, &Path)> = Vec::new();
     for t in tests {
         let files: Vec<&Path> = match &t.recording {
@@ -314,7 +311,7 @@ fn once_each(tests: &[TestInput]) -> Result<(), RtestError> {
         for f in files {
             let Some(id) = FileId::of(f) else { continue };
             if let Some((_, first)) = seen.iter().find(|(i, _)| *i == id) {
-                return Err(RtestError::Io {
+                return Err(MeasuredError::Io {
                     path: f.display().to_string(),
                     message: format!(
                         "the same file as {} (each measured file counts once)",
@@ -331,7 +328,7 @@ fn once_each(tests: &[TestInput]) -> Result<(), RtestError> {
 /// The files of the measured inputs of a command (every file of every test of
 /// [`expand_tests`], in test order; both files of a two-system test): for the provenance of
 /// outputs and for refusing to write over an input.
-pub fn expand_inputs(paths: &[PathBuf]) -> Result<Vec<PathBuf>, RtestError> {
+pub fn expand_inputs(paths: &[PathBuf]) -> Result<Vec<PathBuf>, MeasuredError> {
     Ok(expand_tests(paths)?
         .into_iter()
         .flat_map(|t| match t.recording {

@@ -3,10 +3,11 @@
 //! `direction`, `radius_mm`, `accel_m_s2`, `freq_hz`, `eij_um_s2_per_m`, `std_err_um_s2_per_m`,
 //! `rms_residual_um`) and eij's own additions documented in docs/measurement-files.md.
 
-use super::iso230::{CircleFigures, PathFigures};
-use super::CircleResult;
 use crate::axes::Eij;
+use crate::rtest::iso230::{CircleFigures, PathFigures};
+use crate::rtest::CircleResult;
 use serde::{Deserialize, Serialize};
+use serde_json::Value;
 use std::collections::BTreeMap;
 
 /// EIJ (or their standard errors) keyed by name (`EZZ`, …), µm·s²/m.
@@ -165,4 +166,14 @@ pub struct TimeOffsetJson {
     pub clock: String,
     /// Coarse alignment of the two recordings, ms.
     pub alignment_ms: Option<f64>,
+}
+
+impl CircleResult {
+    /// The CONTRACT.md JSON object of one test (`file`, `plane`, `direction`, `radius_mm`,
+    /// `accel_m_s2`, `freq_hz`, `eij_um_s2_per_m`, `std_err_um_s2_per_m`, `rms_residual_um`)
+    /// plus `measured_radius_mm`, `offsets_um`, `revolutions`, `samples_used`, `plane_fit`,
+    /// `ellipse_fit` (null when it failed) and `warnings`.
+    pub fn to_json(&self) -> Value {
+        serde_json::to_value(CircleJson::from(self)).unwrap_or(Value::Null)
+    }
 }

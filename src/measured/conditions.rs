@@ -4,8 +4,8 @@
 //! entries (`[[test]]`) with their own conditions, including tests recorded by two systems
 //! (an `internal` and an `external` file with their own clocks).
 
+use super::error::MeasuredError;
 use super::layout::{ColumnEntry, ColumnMap};
-use super::RtestError;
 use crate::axes::{Direction, Plane};
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -13,6 +13,9 @@ use std::path::{Path, PathBuf};
 
 /// The file of a folder that states the conditions of the R-Test files in it.
 pub const CONDITIONS_FILE: &str = "rtest.toml";
+
+/// Most tests one command reads (files named, found in folders and in `[[test]]` tables).
+pub const MAX_TESTS: usize = 10_000;
 
 /// Conditions of the circle tests of one folder (`rtest.toml`); absent keys are unknown.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -106,12 +109,12 @@ struct RawTest {
 
 impl TestConditions {
     /// The conditions of `file`: the `rtest.toml` in its folder, or none.
-    pub fn of_file(file: &Path) -> Result<TestConditions, RtestError> {
+    pub fn of_file(file: &Path) -> Result<TestConditions, MeasuredError> {
         Self::of_folder(&folder_of(file))
     }
 
     /// The conditions of the files in `dir`: its `rtest.toml`, or none.
-    pub fn of_folder(dir: &Path) -> Result<TestConditions, RtestError> {
+    pub fn of_folder(dir: &Path) -> Result<TestConditions, MeasuredError> {
         let path = dir.join(CONDITIONS_FILE);
         if std::fs::symlink_metadata(&path).is_err() {
             return Ok(TestConditions::default());
@@ -124,13 +127,13 @@ impl TestConditions {
                 Ok(m) if m.is_dir() => "a folder",
                 Ok(_) => "not a regular file",
             };
-            return Err(RtestError::Io {
+            return Err(MeasuredError::Io {
                 path: name,
                 message: format!("is {what}; the conditions file must be a TOML file"),
             });
         }
         let bytes = super::series::read_bounded(&path, crate::io::read::MAX_TEXT_BYTES)?;
-        let text = String::from_utf8(bytes).map_err(|_| RtestError::Io {
+        let text = String::from_utf8(bytes).map_err(|_| MeasuredError::Io {
             path: name.clone(),
             message: "not valid UTF-8 text".into(),
         })?;
@@ -151,8 +154,8 @@ impl TestConditions {
     /// Parses and validates the text of an `rtest.toml`; `name` stands for the file in error
     /// messages, which name the key or the line and column. Paths of `[[test]]` entries stay
     /// as written (relative to the folder).
-    pub fn from_toml_str(text: &str, name: &str) -> Result<TestConditions, RtestError> {
-        let bad = |key: &str, message: String| RtestError::Conditions {
+    pub fn from_toml_str(text: &str, name: &str) -> Result<TestConditions, MeasuredError> {
+        let bad = |key: &str, message: String| MeasuredError::Conditions {
             file: name.to_string(),
             key: key.to_string(),
             message,
@@ -172,14 +175,10 @@ impl TestConditions {
             columns.overridden_by(&map(&raw.internal_columns, "internal_columns")?);
         let external_columns =
             columns.overridden_by(&map(&raw.external_columns, "external_columns")?);
-        if raw.test.len() > super::inputs::MAX_TESTS {
+        if raw.test.len() > MAX_TESTS {
             return Err(bad(
                 "[[test]]",
-                format!(
-                    "{} entries, at most {}",
-                    raw.test.len(),
-                    super::inputs::MAX_TESTS
-                ),
+                format!("{} entries, at most {}", raw.test.len(), MAX_TESTS),
             ));
         }
         let mut tests = Vec::new();
@@ -201,8 +200,8 @@ impl TestConditions {
 fn check_radius(
     r: Option<f64>,
     key: &str,
-    bad: &dyn Fn(&str, String) -> RtestError,
-) -> Result<(), RtestError> {
+    bad: &dyn Fn(&str, String) -> MeasuredError,
+) -> Result<(), MeasuredError> {
     match r {
         Some(r) if !(r.is_finite() && r > 0.0 && r <= 3.0) => Err(bad(
             key,
@@ -215,8 +214,8 @@ fn check_radius(
 fn check_position(
     p: Option<&[f64]>,
     key: &str,
-    bad: &dyn Fn(&str, String) -> RtestError,
-) -> Result<(), RtestError> {
+    bad: &dyn Fn(&str, String) -> MeasuredError,
+) -> Result<(), MeasuredError> {
     match p {
         Some(p) if p.iter().any(|v| !v.is_finite()) => {
             Err(bad(key, "values must be finite".into()))
@@ -236,8 +235,8 @@ fn check_position(
 fn test_entry(
     number: usize,
     t: RawTest,
-    bad: &dyn Fn(&str, String) -> RtestError,
-) -> Result<TestEntry, RtestError> {
+    bad: &dyn Fn(&str, String) -> MeasuredError,
+) -> Result<TestEntry, MeasuredError> {
     let key = |k: &str| format!("[[test]] #{number} {k}");
     let recording = match (t.file, t.internal, t.external) {
         (Some(f), None, None) => Recording::Single(f),

@@ -5,11 +5,12 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::error::{quote_cell, Location, RtestError};
-use super::layout::{csv_error, parse_decimal, LineCounter};
+use super::error::MeasuredError;
+use super::layout::{csv_error, parse_decimal};
 use super::series::{column_indices, read_bounded, require_columns};
-use super::CircleResult;
 use crate::axes::{Direction, Eij, Plane};
+use crate::io::delimited::{header_line, header_separator, quote_cell, LineCounter};
+use crate::rtest::{CircleResult, Location, RtestError};
 use crate::text::num;
 
 /// Whether a file looks like an EIJ table (its header has a `parameter` column) rather than a
@@ -30,8 +31,8 @@ pub fn looks_like_table(path: &Path) -> bool {
     }
     head(path)
         .map(|b| {
-            let sep = super::layout::header_separator(&b);
-            super::layout::header_line(&b).is_some_and(|line| {
+            let sep = header_separator(&b);
+            header_line(&b).is_some_and(|line| {
                 String::from_utf8_lossy(line)
                     .split(sep as char)
                     .any(|c| c.trim().trim_matches('"') == "parameter")
@@ -94,7 +95,7 @@ pub fn rows_from_result(result: &CircleResult) -> Vec<EijRow> {
 /// a finite positive standard error (an empty cell means unknown); no parameter of a test
 /// (plane, direction, acceleration) twice. At least one row. Separator `,`, `;` or tab (decimal
 /// comma where `,` is not the separator) and `#` comment lines are recognised.
-pub fn read(path: impl AsRef<Path>) -> Result<Vec<EijRow>, RtestError> {
+pub fn read(path: impl AsRef<Path>) -> Result<Vec<EijRow>, MeasuredError> {
     let path = path.as_ref();
     let bytes = read_bounded(path, crate::io::read::MAX_TEXT_BYTES)?;
     from_bytes(&path.display().to_string(), &bytes)
@@ -102,10 +103,10 @@ pub fn read(path: impl AsRef<Path>) -> Result<Vec<EijRow>, RtestError> {
 
 /// As [`read`] on the bytes of a file already read; `name` stands for the file in error
 /// messages. A leading UTF-8 byte-order mark is dropped.
-pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<Vec<EijRow>, RtestError> {
+pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<Vec<EijRow>, MeasuredError> {
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     let name = name.to_string();
-    let separator = super::layout::header_separator(bytes);
+    let separator = header_separator(bytes);
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(false)
         .delimiter(separator)
@@ -121,7 +122,7 @@ pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<Vec<EijRow>, RtestError> {
     let expected = || format!("{},{}", COLUMNS.join(","), STD_ERR_COLUMN);
     let header = match records.next() {
         None => {
-            return Err(RtestError::Empty {
+            return Err(MeasuredError::Empty {
                 at: Location::source(&name),
                 expected: expected(),
             })
@@ -139,7 +140,7 @@ pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<Vec<EijRow>, RtestError> {
     ];
     // An unknown column is refused: a typo must not drop the standard errors silently.
     let index = column_indices(&header, &wanted, &header_at, |cell| {
-        Err(RtestError::UnknownColumn {
+        Err(MeasuredError::UnknownColumn {
             at: header_at.clone(),
             column: quote_cell(cell),
             expected: expected(),
@@ -156,7 +157,7 @@ pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<Vec<EijRow>, RtestError> {
         // keeps such text readable and on one line in the error.
         let raw = |k: usize| record.get(index[k]).unwrap_or("");
         let cell = |k: usize| quote_cell(raw(k));
-        let bad = |k: usize, message: String| RtestError::BadValue {
+        let bad = |k: usize, message: String| MeasuredError::BadValue {
             at: at(),
             column: COLUMNS[k].to_string(),
             message,
@@ -206,7 +207,7 @@ pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<Vec<EijRow>, RtestError> {
                 text => {
                     let s = number(text, line, STD_ERR_COLUMN)?;
                     if s <= 0.0 || s > MAX_EIJ {
-                        return Err(RtestError::BadValue {
+                        return Err(MeasuredError::BadValue {
                             at: at(),
                             column: STD_ERR_COLUMN.into(),
                             message: format!(
@@ -247,7 +248,8 @@ pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<Vec<EijRow>, RtestError> {
             at: Location::source(&name),
             rows: 0,
             needed: 1,
-        });
+        }
+        .into());
     }
     Ok(rows)
 }
@@ -281,7 +283,11 @@ pub fn to_csv(rows: &[EijRow]) -> String {
 
 /// Writes the table atomically ([`crate::io::write_atomic`]); refuses to replace any of
 /// `inputs`.
-pub fn write(path: impl AsRef<Path>, rows: &[EijRow], inputs: &[&Path]) -> Result<(), RtestError> {
+pub fn write(
+    path: impl AsRef<Path>,
+    rows: &[EijRow],
+    inputs: &[&Path],
+) -> Result<(), MeasuredError> {
     crate::io::write_atomic(path.as_ref(), to_csv(rows).as_bytes(), inputs)?;
     Ok(())
 }

@@ -1,17 +1,17 @@
 //! Evaluation of the circle tests of a command (`eij evaluate`, `identify`, `report`): every
 //! test read with its folder's conditions, tests recorded by two systems brought onto one time
-//! base, clock offsets estimated per clock (see [`super::clock`], [`super::clock_fit`]), each
+//! base, clock offsets estimated per clock (see [`crate::rtest::clock`], [`crate::rtest::clock_fit`]), each
 //! test evaluated at its set radius, and cw/ccw pairs given their ISO 230-4 bi-directional
 //! circular deviation.
 
-use super::clock::{self, Recording as Record};
 use super::conditions::Recording;
-use super::error::RtestError;
+use super::error::MeasuredError;
 use super::inputs::TestInput;
-use super::normalise::Normalised;
-use super::{evaluate, iso230, CircleResult, CircleSeries, EvalOptions};
+use super::json::{CircleJson, TestJson, TimeOffsetJson};
 use crate::axes::{Direction, Eij, Plane};
-use crate::rtest::json::{CircleJson, TestJson, TimeOffsetJson};
+use crate::rtest::clock::{self, Recording as Record};
+use crate::rtest::normalise::Normalised;
+use crate::rtest::{evaluate, iso230, CircleResult, CircleSeries, EvalOptions};
 use rayon::prelude::*;
 
 mod clocks;
@@ -138,17 +138,17 @@ pub(super) fn group_key(input: &TestInput, norm: &Normalised) -> String {
 }
 
 /// Reads, aligns and evaluates `inputs` (see the module docs).
-pub fn evaluate_tests(inputs: &[TestInput], opts: &SuiteOptions) -> Result<Suite, RtestError> {
+pub fn evaluate_tests(inputs: &[TestInput], opts: &SuiteOptions) -> Result<Suite, MeasuredError> {
     // Files are read and evaluated in parallel; the first error in input order is reported.
     let prepared: Vec<Prepared> = inputs
         .par_iter()
-        .map(|input| -> Result<Prepared, RtestError> {
+        .map(|input| -> Result<Prepared, MeasuredError> {
             let (eval, source) = eval_options(input, opts);
             let data = match &input.recording {
                 Recording::Single(_) => Data::Single(input.read_single()?),
                 Recording::Split { internal, external } => Data::Split {
-                    internal: Record::read_internal(internal, &input.internal_columns)?,
-                    external: Record::read_external(external, &input.external_columns)?,
+                    internal: super::recording::read_internal(internal, &input.internal_columns)?,
+                    external: super::recording::read_external(external, &input.external_columns)?,
                 },
             };
             Ok(Prepared {
@@ -193,7 +193,7 @@ pub fn evaluate_tests(inputs: &[TestInput], opts: &SuiteOptions) -> Result<Suite
         })
         .collect::<Vec<_>>()
         .into_iter()
-        .collect::<Result<_, RtestError>>()?;
+        .collect::<Result<_, MeasuredError>>()?;
     let mut tests = Vec::with_capacity(inputs.len());
     for (((input, p), offset), (series, mut result)) in
         inputs.iter().zip(prepared).zip(offsets).zip(evaluated)
@@ -246,21 +246,24 @@ pub(super) fn series_at(
     input: &TestInput,
     data: &Data,
     offset_s: Option<f64>,
-) -> Result<CircleSeries, RtestError> {
+) -> Result<CircleSeries, MeasuredError> {
     match (data, offset_s) {
         (Data::Single(s), None) => Ok(s.clone()),
         (Data::Single(s), Some(o)) => {
             let (int, ext) = split_series(s)?;
-            clock::merge(input.name(), &int, &ext, o)
+            Ok(clock::merge(input.name(), &int, &ext, o)?)
         }
-        (Data::Split { internal, external }, o) => {
-            clock::merge(input.name(), internal, external, o.unwrap_or(0.0))
-        }
+        (Data::Split { internal, external }, o) => Ok(clock::merge(
+            input.name(),
+            internal,
+            external,
+            o.unwrap_or(0.0),
+        )?),
     }
 }
 
 /// A single-file series as its two recordings on the same clock.
-fn split_series(s: &CircleSeries) -> Result<(Record, Record), RtestError> {
+fn split_series(s: &CircleSeries) -> Result<(Record, Record), MeasuredError> {
     use crate::axes::Axis;
     let int = Axis::ALL.map(|a| s.int_mm(a).to_vec());
     let ext = Axis::ALL.map(|a| s.ext_mm(a).to_vec());

@@ -16,7 +16,12 @@ use std::collections::BTreeMap;
 
 use serde::Deserialize;
 
-use super::error::{quote_cell, Line, Location, RtestError};
+use super::error::MeasuredError;
+use crate::io::delimited::{
+    csv_message, is_comment_or_blank, lines, parse_number, quote_cell, separator_of, BadNumber,
+    LineCounter,
+};
+use crate::rtest::{Line, Location};
 
 /// Lines (not comments) searched for the header: a metadata block longer than this is not
 /// recognised.
@@ -134,10 +139,10 @@ impl ColumnMap {
         entries: &BTreeMap<String, ColumnEntry>,
         file: &str,
         table: &str,
-    ) -> Result<ColumnMap, RtestError> {
+    ) -> Result<ColumnMap, MeasuredError> {
         let mut specs = BTreeMap::new();
         for (key, entry) in entries {
-            let bad = |k: String, message: String| RtestError::Conditions {
+            let bad = |k: String, message: String| MeasuredError::Conditions {
                 file: file.to_string(),
                 key: k,
                 message,
@@ -200,7 +205,7 @@ impl ColumnMap {
                 .find(|o| effective(o).eq_ignore_ascii_case(&name))
             {
                 let key = if specs.contains_key(*c) { c } else { other };
-                return Err(RtestError::Conditions {
+                return Err(MeasuredError::Conditions {
                     file: file.to_string(),
                     key: format!("{table}.{key}.name"),
                     message: format!(
@@ -272,58 +277,6 @@ pub struct Table {
     pub dialect: Dialect,
 }
 
-/// The lines of a text, without line ends, with their 1-based numbers and byte offsets.
-fn lines(bytes: &[u8]) -> impl Iterator<Item = (u64, usize, &[u8])> {
-    let mut start = 0;
-    let mut number = 0;
-    std::iter::from_fn(move || {
-        if start >= bytes.len() {
-            return None;
-        }
-        let end = bytes[start..]
-            .iter()
-            .position(|&b| b == b'\n')
-            .map_or(bytes.len(), |p| start + p);
-        let line = &bytes[start..end];
-        let line = line.strip_suffix(b"\r").unwrap_or(line);
-        number += 1;
-        let item = (number, start, line);
-        start = end + 1;
-        Some(item)
-    })
-}
-
-fn is_comment_or_blank(line: &[u8]) -> bool {
-    let trimmed = line.trim_ascii_start();
-    trimmed.is_empty() || trimmed[0] == b'#'
-}
-
-/// The separator of a header line: the candidate that splits it into the most cells (`,` on a
-/// tie, and for a line without any).
-pub fn separator_of(line: &[u8]) -> u8 {
-    let mut best = (0, b',');
-    for sep in [b',', b';', b'\t'] {
-        let count = line.iter().filter(|&&b| b == sep).count();
-        if count > best.0 {
-            best = (count, sep);
-        }
-    }
-    best.1
-}
-
-/// The first line that is no comment and not blank (a byte-order mark dropped).
-pub fn header_line(bytes: &[u8]) -> Option<&[u8]> {
-    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
-    lines(bytes)
-        .map(|(_, _, l)| l)
-        .find(|l| !is_comment_or_blank(l))
-}
-
-/// The separator of a file's header line (see [`separator_of`]).
-pub fn header_separator(bytes: &[u8]) -> u8 {
-    header_line(bytes).map_or(b',', separator_of)
-}
-
 /// A header cell as compared with column names: trimmed, quotes removed, lower case.
 fn normalise_name(cell: &str) -> String {
     let t = cell.trim();
@@ -349,7 +302,7 @@ pub fn read_table(
     bytes: &[u8],
     wanted: &[&str],
     map: &ColumnMap,
-) -> Result<Table, RtestError> {
+) -> Result<Table, MeasuredError> {
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     let specs: Vec<ColumnSpec> = wanted.iter().map(|w| map.spec(w)).collect();
     let keys: Vec<String> = specs.iter().map(|s| normalise_name(&s.name)).collect();
@@ -376,7 +329,7 @@ pub fn read_table(
     }
     let Some((header_line, offset)) = header else {
         return Err(match first {
-            None => RtestError::Empty {
+            None => MeasuredError::Empty {
                 at: Location::source(name),
                 expected: specs
                     .iter()
@@ -384,10 +337,12 @@ pub fn read_table(
                     .collect::<Vec<_>>()
                     .join(","),
             },
-            Some((number, _, line, _)) if std::str::from_utf8(line).is_err() => RtestError::Csv {
-                at: Location::file_line(name, number),
-                message: "not valid UTF-8 text".into(),
-            },
+            Some((number, _, line, _)) if std::str::from_utf8(line).is_err() => {
+                MeasuredError::Csv {
+                    at: Location::file_line(name, number),
+                    message: "not valid UTF-8 text".into(),
+                }
+            }
             Some((number, _, line, _)) => {
                 let sep = separator_of(line);
                 let cells = split_header(line, sep);
@@ -409,7 +364,7 @@ pub fn read_table(
                     decimal_comma: false,
                     header_line: number,
                 };
-                RtestError::MissingColumns {
+                MeasuredError::MissingColumns {
                     at: Location::file_line(name, number),
                     columns: missing,
                     header: Some(format!(
@@ -441,7 +396,7 @@ pub fn read_table(
         let cell = normalise_name(cell);
         if let Some(k) = keys.iter().position(|key| *key == cell) {
             if index[k] != usize::MAX {
-                return Err(RtestError::DuplicateColumn {
+                return Err(MeasuredError::DuplicateColumn {
                     at: header_at,
                     column: quote_cell(&specs[k].name),
                 });
@@ -477,89 +432,16 @@ pub fn read_table(
     })
 }
 
-/// Physical line numbers (1-based) of byte offsets, counted forward through the file: the CSV
-/// reader's own line count leaves out blank lines.
-pub(crate) struct LineCounter<'a> {
-    bytes: &'a [u8],
-    byte: usize,
-    line: u64,
-}
-
-impl<'a> LineCounter<'a> {
-    /// A counter at the start of `bytes` (line 1).
-    pub(crate) fn new(bytes: &'a [u8]) -> Self {
-        Self::starting_at(bytes, 1)
-    }
-
-    /// A counter at the start of `bytes`, which begin on line `line` of their file.
-    pub(crate) fn starting_at(bytes: &'a [u8], line: u64) -> Self {
-        LineCounter {
-            bytes,
-            byte: 0,
-            line,
-        }
-    }
-
-    /// The line holding byte `offset`; offsets must not decrease between calls.
-    pub(crate) fn line_of(&mut self, offset: u64) -> u64 {
-        let end = (offset as usize).min(self.bytes.len());
-        if end > self.byte {
-            let newlines = self.bytes[self.byte..end]
-                .iter()
-                .filter(|&&b| b == b'\n')
-                .count();
-            self.line += newlines as u64;
-            self.byte = end;
-        }
-        self.line
-    }
-
-    /// The line of a record: of its first byte that is not a line end (the reader's record
-    /// position may point at the end of the previous line or at skipped blank lines).
-    pub(crate) fn line_of_record(&mut self, record: &csv::StringRecord) -> u64 {
-        match record.position() {
-            Some(p) => self.line_of_position(p),
-            None => self.line,
-        }
-    }
-
-    /// The line of a reader position, skipping line ends as [`Self::line_of_record`] does.
-    pub(crate) fn line_of_position(&mut self, p: &csv::Position) -> u64 {
-        let mut start = p.byte() as usize;
-        while self
-            .bytes
-            .get(start)
-            .is_some_and(|b| *b == b'\r' || *b == b'\n')
-        {
-            start += 1;
-        }
-        self.line_of(start as u64)
-    }
-}
-
 /// Turns a CSV reader error into a one-line error naming the line.
-pub(crate) fn csv_error(source: &str, lines: &mut LineCounter, e: csv::Error) -> RtestError {
+pub(crate) fn csv_error(source: &str, lines: &mut LineCounter, e: csv::Error) -> MeasuredError {
     let line = e.position().map(|p| lines.line_of_position(p));
     let message = csv_message(&e);
-    RtestError::Csv {
+    MeasuredError::Csv {
         at: Location {
             source: source.to_string(),
             line: line.map(Line::File),
         },
         message,
-    }
-}
-
-/// What a CSV reader's error says, without its own position (the caller names file and line:
-/// the reader's "CSV error: record 2 (line: 3, byte: 120)" would repeat them).
-pub(crate) fn csv_message(e: &csv::Error) -> String {
-    match e.kind() {
-        csv::ErrorKind::UnequalLengths {
-            expected_len, len, ..
-        } => format!("{len} field(s), the header has {expected_len}"),
-        csv::ErrorKind::Utf8 { .. } => "not valid UTF-8 text".to_string(),
-        csv::ErrorKind::Io(io) => io.to_string(),
-        _ => e.to_string(),
     }
 }
 
@@ -571,24 +453,13 @@ pub(crate) fn parse_decimal(
     source: &str,
     line: u64,
     column: &str,
-) -> Result<f64, RtestError> {
+) -> Result<f64, MeasuredError> {
     let at = || Location::file_line(source, line);
-    let parsed = if decimal_comma && text.contains(',') && !text.contains('.') {
-        text.replace(',', ".").parse::<f64>()
-    } else {
-        text.parse::<f64>()
-    };
-    match parsed {
-        Err(_) => Err(RtestError::NotANumber {
-            at: at(),
-            column: column.to_string(),
-            value: quote_cell(text),
-        }),
-        Ok(v) if !v.is_finite() => Err(RtestError::NotFinite {
-            at: at(),
-            column: column.to_string(),
-            value: quote_cell(text),
-        }),
-        Ok(v) => Ok(v),
-    }
+    parse_number(text, decimal_comma).map_err(|bad| {
+        let (at, column, value) = (at(), column.to_string(), quote_cell(text));
+        match bad {
+            BadNumber::NotANumber => MeasuredError::NotANumber { at, column, value },
+            BadNumber::NotFinite => MeasuredError::NotFinite { at, column, value },
+        }
+    })
 }

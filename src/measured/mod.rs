@@ -1,0 +1,36 @@
+//! What was measured, read from files: R-Test circle-test series in their CSV dialects and
+//! column maps ([`layout`], [`series`]), a folder's test conditions (`rtest.toml`, [`conditions`])
+//! and the tests they make ([`inputs`]), two-system recordings ([`recording`]), EIJ tables
+//! ([`table`]) and the evaluation JSON ([`json`]), positioning moves ([`moves`]); and the
+//! evaluation of a command's measured tests as one suite ([`suite`]: clocks aligned, each test
+//! evaluated by [`crate::rtest`] at its conditions, cw/ccw pairs).
+//!
+//! A new file format goes here: a reader into the types [`crate::rtest`] evaluates, with its
+//! errors as [`MeasuredError`] (one line naming file, line or key, and what is wrong).
+//!
+//! ```no_run
+//! use eij::measured::inputs::expand_tests;
+//! use eij::measured::suite::{evaluate_tests, SuiteOptions};
+//!
+//! # fn main() -> Result<(), eij::measured::MeasuredError> {
+//! let tests = expand_tests(&["measurements/demo-vmc/pos-a".into()])?;
+//! let suite = evaluate_tests(&tests, &SuiteOptions::default())?;
+//! for t in &suite.tests {
+//!     println!("{} {:?}", t.result.source, t.result.eij);
+//! }
+//! # Ok(())
+//! # }
+//! ```
+
+pub mod conditions;
+pub mod error;
+pub mod inputs;
+pub mod json;
+pub mod layout;
+pub mod moves;
+pub mod recording;
+pub mod series;
+pub mod suite;
+pub mod table;
+
+pub use error::MeasuredError;

@@ -1,0 +1,32 @@
+//! The files of a test recorded by two systems (`[[test]]` with `internal` and `external`):
+//! each read into one system's [`Recording`] on its own clock, to be brought onto one time
+//! base by [`crate::rtest::clock`].
+
+use std::path::Path;
+
+use super::error::MeasuredError;
+use super::layout::{read_table, ColumnMap};
+use super::series::read_file;
+use crate::rtest::clock::Recording;
+use crate::rtest::series::{EXT_COLUMNS, INT_COLUMNS, TIME_COLUMN};
+
+/// Reads the internal file of a two-system test: `t_s` and `{x,y,z}_int_mm`.
+pub fn read_internal(path: &Path, map: &ColumnMap) -> Result<Recording, MeasuredError> {
+    read(path, map, &INT_COLUMNS)
+}
+
+/// Reads the external file of a two-system test: `t_s` and `{x,y,z}_ext_mm`.
+pub fn read_external(path: &Path, map: &ColumnMap) -> Result<Recording, MeasuredError> {
+    read(path, map, &EXT_COLUMNS)
+}
+
+fn read(path: &Path, map: &ColumnMap, columns: &[&str; 3]) -> Result<Recording, MeasuredError> {
+    let name = path.display().to_string();
+    let bytes = read_file(path)?;
+    let wanted = [TIME_COLUMN, columns[0], columns[1], columns[2]];
+    let table = read_table(&name, &bytes, &wanted, map)?;
+    let mut cols = table.columns.into_iter();
+    let mut next = || cols.next().unwrap_or_default();
+    let (t_s, mm) = (next(), [next(), next(), next()]);
+    Ok(Recording::with_lines(name, t_s, mm, table.lines)?)
+}
