@@ -344,6 +344,7 @@ impl Machine {
                 modes: modes.unwrap_or(DEFAULT_MODES),
                 cutoff_hz,
                 attach_radius_m: radius,
+                interface_modes: None,
                 full_reference: false,
             };
             let (attachments, reach) = self.attachments(b);
