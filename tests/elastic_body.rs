@@ -54,6 +54,9 @@ impl HandMadeHead {
 }
 
 impl ElasticModel for HandMadeHead {
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
     fn cog_m(&self) -> Vector3<f64> {
         self.cog
     }

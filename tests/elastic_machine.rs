@@ -7,6 +7,7 @@
 use eij::axes::{Axis, Direction, Eij, Plane};
 use eij::ident::{identify, Parameter, Problem, Settings, TestCase};
 use eij::machine::catalogue::Catalogue;
+use eij::machine::elastic::FeBody;
 use eij::machine::Machine;
 use eij::mbs::Model;
 use eij::predict::{simulated_eij, CircleTest, EijMap};
@@ -63,7 +64,7 @@ fn the_column_is_reduced_once_per_run() {
     let reduction = |m: &Machine| {
         m.bodies()[column(m)]
             .elastic()
-            .and_then(|e| e.model().fe())
+            .and_then(|e| e.model().as_any().downcast_ref::<FeBody>())
             .map(|f| f.reduction().clone())
             .unwrap()
     };

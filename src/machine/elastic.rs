@@ -142,8 +142,8 @@ impl ElasticModel for FeBody {
         };
         Some(DMatrix::from_iterator(6, g.ncols(), g.iter().copied()))
     }
-    fn fe(&self) -> Option<&FeBody> {
-        Some(self)
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
     }
 }
 
