@@ -77,6 +77,26 @@ impl Machine {
             }
             let cog = b.cog_m.unwrap_or([0.0; 3]);
             coords(&cog).map_err(|m| err(key("cog_m"), m))?;
+            let elastic = b.fe.is_some() || b.beam.is_some();
+            if b.fixed && elastic {
+                let which = if b.fe.is_some() { "fe" } else { "beam" };
+                return Err(err(
+                    key(which),
+                    "a fixed body cannot be elastic (it has no coordinates)".into(),
+                ));
+            }
+            if elastic {
+                // Mass properties come from the FE model (with_elastic_bodies below), checked
+                // against these where they are given.
+                bodies.push(Body {
+                    name: b.name.clone(),
+                    mass_kg: b.mass_kg.unwrap_or(0.0),
+                    cog_m: Vector3::from(cog),
+                    inertia_kg_m2: Matrix3::zeros(),
+                    kind: BodyKind::Rigid,
+                });
+                continue;
+            }
             if b.fixed {
                 bodies.push(Body {
                     name: b.name.clone(),
@@ -261,8 +281,27 @@ impl Machine {
         }
 
         let mut joints = Vec::with_capacity(raw.joints.len());
-        for j in &raw.joints {
+        for (i, j) in raw.joints.iter().enumerate() {
             let key = |k: &str| format!("joint[{}].{k}", j.name);
+            // A block pasted twice would double the joint's stiffness unseen.
+            if raw.joints[..i].iter().any(|o| o.name == j.name) {
+                return Err(err(
+                    key("name"),
+                    "duplicate joint name (a [[joint]] block given twice?)".into(),
+                ));
+            }
+            if let Some(o) = raw.joints[..i].iter().find(|o| {
+                o.point_m == j.point_m
+                    && [(&o.body, &o.other), (&o.other, &o.body)].contains(&(&j.body, &j.other))
+            }) {
+                return Err(err(
+                    key("point_m"),
+                    format!(
+                        "joint {} already joins {} and {} at this point (one joint per point; give its stiffness once)",
+                        o.name, j.body, j.other
+                    ),
+                ));
+            }
             let body = body_index(&j.body, key("body"))?;
             let other = body_index(&j.other, key("other"))?;
             if body == other {
@@ -309,7 +348,8 @@ impl Machine {
             });
         }
 
-        Ok(Machine {
+        let raw_bodies = raw.bodies.clone();
+        Machine {
             name: raw.name.clone(),
             source: file.to_string(),
             rayleigh_beta_s: raw.rayleigh_beta_s,
@@ -320,7 +360,8 @@ impl Machine {
             joints,
             moved_by,
             raw: std::sync::Arc::new(raw),
-        })
+        }
+        .with_elastic_bodies(&raw_bodies)
     }
 }
 

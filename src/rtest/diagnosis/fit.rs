@@ -185,5 +185,7 @@ fn term(spec: &Spec, solved: &Solved, contribution_um: f64, figure: Figure, plan
         figure,
         crossings,
         notes: Vec::new(),
+        limit: None,
+        verdict: None,
     }
 }

@@ -54,6 +54,7 @@ pub mod decompose;
 mod fit;
 pub mod separate;
 pub mod terms;
+pub mod tolerance;
 
 pub use separate::{separate, GroupSeparation};
 
@@ -89,6 +90,12 @@ pub enum Source {
     Structure,
     /// The external reading (TCP).
     Tcp,
+}
+
+impl serde::Serialize for Source {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
 }
 
 impl Source {
@@ -157,6 +164,12 @@ pub struct Term {
     /// What the value may also be, and what tests at other accelerations or directions said.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub notes: Vec<String>,
+    /// The tolerance on |value|, where `[tolerances]` gives one ([`tolerance::judge`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub limit: Option<f64>,
+    /// `pass` or `fail` against `limit`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub verdict: Option<&'static str>,
 }
 
 /// The decomposition of one source of one test.

@@ -305,6 +305,8 @@ fn write_back(
                 test.plane.axes().1,
                 test.feed_mm_min
             )],
+            limit: None,
+            verdict: None,
         };
         let sd = &mut test.sources[source as usize];
         sd.terms.push(servo);
