@@ -171,6 +171,16 @@ fn check_samples(common: &Common, sp: &dyn SetPoint, freq_hz: Option<f64>) -> an
             common.decimals
         );
     }
+    // Rounded times must still tell the samples apart, to a tenth of a sample, and lengths
+    // in mm need at least 1 µm (else `t_s` repeats and eij's own evaluation refuses the file).
+    let needed = ((10.0 * rate).log10().ceil() as usize).max(3);
+    if common.decimals < needed {
+        bail!(
+            "--decimals {}: at {rate} Hz (a sample every {} s) t_s needs at least {needed} decimals",
+            common.decimals,
+            eij::text::num(1.0 / rate)
+        );
+    }
     let samples = sp.duration_s() * rate;
     if samples.is_nan() || samples > MAX_SAMPLES {
         bail!(

@@ -93,6 +93,12 @@ impl IdentConfig {
             }
             Ok(v)
         };
+        if self.parameters.as_ref().is_some_and(|p| p.is_empty()) {
+            return Err(bad(
+                "parameters",
+                "[] names no parameter: name at least one, or leave the key out for the default set (normal and lateral guideway factor of every axis)".into(),
+            ));
+        }
         if let Some(v) = self.method {
             s.method = v;
         }

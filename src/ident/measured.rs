@@ -125,11 +125,48 @@ pub fn load_measured(paths: &[PathBuf], opts: &MeasuredOptions) -> Result<Measur
             ),
         });
     }
+    if let Some((input, message)) = table_of_series(&tests) {
+        return Err(IdentError::Test { input, message });
+    }
     Ok(Measured {
         tests,
         warnings,
         clocks,
     })
+}
+
+/// An EIJ table's test that repeats a measured series' evaluation (the table made from
+/// that series, e.g. by `evaluate --csv-out`, lying beside it): same plane, direction,
+/// acceleration and circle centre, and every EIJ the same within rounding to three decimals.
+/// Both would count, the test twice, and the standard errors come out too small. (A repeated
+/// measurement of the same conditions has its own noise: its EIJ differ by far more.) Returns
+/// the table's test and what is wrong, for the error that refuses it.
+fn table_of_series(tests: &[TestCase]) -> Option<(String, String)> {
+    let same = |a: f64, b: f64| (a - b).abs() <= 1e-3 + 1e-6 * a.abs().max(b.abs());
+    let (tables, series): (Vec<&TestCase>, Vec<&TestCase>) =
+        tests.iter().partition(|t| t.clock.is_none());
+    for t in tables {
+        let repeated = series.iter().find(|s| {
+            s.circle.plane == t.circle.plane
+                && s.circle.direction == t.circle.direction
+                && same(s.circle.accel_m_s2, t.circle.accel_m_s2)
+                && s.circle.position_m == t.circle.position_m
+                && !t.measured.is_empty()
+                && t.measured
+                    .iter()
+                    .all(|(p, (v, _))| s.measured.get(p).is_some_and(|(w, _)| same(*v, *w)))
+        });
+        if let Some(s) = repeated {
+            return Some((
+                t.source.clone(),
+                format!(
+                    "the EIJ of the measured series {} again (same plane, direction, acceleration, circle centre and values): a table made from a series counts its test twice; give the series or the table",
+                    s.source
+                ),
+            ));
+        }
+    }
+    None
 }
 
 /// The tests of an EIJ table, one per plane, direction and acceleration.

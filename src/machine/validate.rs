@@ -261,8 +261,27 @@ impl Machine {
         }
 
         let mut joints = Vec::with_capacity(raw.joints.len());
-        for j in &raw.joints {
+        for (i, j) in raw.joints.iter().enumerate() {
             let key = |k: &str| format!("joint[{}].{k}", j.name);
+            // A block pasted twice would double the joint's stiffness unseen.
+            if raw.joints[..i].iter().any(|o| o.name == j.name) {
+                return Err(err(
+                    key("name"),
+                    "duplicate joint name (a [[joint]] block given twice?)".into(),
+                ));
+            }
+            if let Some(o) = raw.joints[..i].iter().find(|o| {
+                o.point_m == j.point_m
+                    && [(&o.body, &o.other), (&o.other, &o.body)].contains(&(&j.body, &j.other))
+            }) {
+                return Err(err(
+                    key("point_m"),
+                    format!(
+                        "joint {} already joins {} and {} at this point (one joint per point; give its stiffness once)",
+                        o.name, j.body, j.other
+                    ),
+                ));
+            }
             let body = body_index(&j.body, key("body"))?;
             let other = body_index(&j.other, key("other"))?;
             if body == other {

@@ -308,9 +308,47 @@ pub fn expand_tests(paths: &[PathBuf]) -> Result<Vec<TestInput>, MeasuredError> 
     Ok(tests)
 }
 
-/// Refuses a measured file reached twice (named twice, in two folders given, through a link):
-/// it would count twice and make the standard errors too small.
+/// Whether the regular files `a` and `b`, of equal size, hold the same bytes (read in chunks,
+/// stopping at the first difference).
+fn same_content(a: &Path, b: &Path) -> bool {
+    use std::io::Read;
+    let (Ok(fa), Ok(fb)) = (std::fs::File::open(a), std::fs::File::open(b)) else {
+        return false;
+    };
+    let (mut ra, mut rb) = (std::io::BufReader::new(fa), std::io::BufReader::new(fb));
+    let (mut ba, mut bb) = (vec![0u8; 1 << 16], vec![0u8; 1 << 16]);
+    loop {
+        let (Ok(na), Ok(nb)) = (
+            ra.read(&mut ba).and_then(|n| fill(&mut ra, &mut ba, n)),
+            rb.read(&mut bb).and_then(|n| fill(&mut rb, &mut bb, n)),
+        ) else {
+            return false;
+        };
+        if na != nb || ba[..na] != bb[..nb] {
+            return false;
+        }
+        if na == 0 {
+            return true;
+        }
+    }
+}
+
+/// Reads on until `buf` is full or the file ends, `n` bytes already in it.
+fn fill(r: &mut impl std::io::Read, buf: &mut [u8], mut n: usize) -> std::io::Result<usize> {
+    while n > 0 && n < buf.len() {
+        match r.read(&mut buf[n..])? {
+            0 => break,
+            k => n += k,
+        }
+    }
+    Ok(n)
+}
+
+/// Refuses a measured file reached twice (named twice, in two folders given, through a link),
+/// and a byte-identical copy of one (a folder copied beside itself): either would count its
+/// test twice and make the standard errors too small.
 fn once_each(tests: &[TestInput]) -> Result<(), MeasuredError> {
+    refuse_copies(tests)?;
     let mut seen: Vec<(FileId, &Path)> = Vec::new();
     for t in tests {
         let files: Vec<&Path> = match &t.recording {
@@ -329,6 +367,40 @@ fn once_each(tests: &[TestInput]) -> Result<(), MeasuredError> {
                 });
             }
             seen.push((id, f));
+        }
+    }
+    Ok(())
+}
+
+/// Refuses two measured files with the same bytes (regular files of equal size compared).
+fn refuse_copies(tests: &[TestInput]) -> Result<(), MeasuredError> {
+    let mut sized: Vec<(u64, &Path)> = Vec::new();
+    for t in tests {
+        let files: Vec<&Path> = match &t.recording {
+            Recording::Single(f) => vec![f],
+            Recording::Split { internal, external } => vec![internal, external],
+        };
+        for f in files {
+            let Ok(m) = std::fs::metadata(f) else {
+                continue;
+            };
+            if !m.is_file() {
+                continue;
+            }
+            let copy_of = sized
+                .iter()
+                .filter(|(len, other)| *len == m.len() && FileId::of(other) != FileId::of(f))
+                .find(|(_, other)| same_content(other, f));
+            if let Some((_, first)) = copy_of {
+                return Err(MeasuredError::Io {
+                    path: f.display().to_string(),
+                    message: format!(
+                        "the same content as {} (a copy would count its test twice; give one of them)",
+                        first.display()
+                    ),
+                });
+            }
+            sized.push((m.len(), f));
         }
     }
     Ok(())
