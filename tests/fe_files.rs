@@ -7,20 +7,7 @@ use fe_common::dense;
 use std::path::{Path, PathBuf};
 
 fn beam() -> Beam {
-    Beam {
-        from_m: [0.0, 0.6, -0.1],
-        to_m: [0.0, 0.6, 1.1],
-        elements: 3,
-        y_axis: [1.0, 0.0, 0.0],
-        area_m2: 0.05,
-        iy_m4: 1.0e-3,
-        iz_m4: 1.2e-3,
-        torsion_m4: 1.5e-3,
-        shear_factor: 0.5,
-        youngs_modulus_pa: 1.2e11,
-        shear_modulus_pa: 4.6e10,
-        density_kg_m3: 7200.0,
-    }
+    fe_common::contract_beam(3, 1.2e11, 4.6e10)
 }
 
 /// A fresh folder for one test's files.

@@ -34,6 +34,7 @@ fn settings(cutoff_hz: Option<f64>) -> ReductionSettings {
         modes: 20,
         cutoff_hz,
         attach_radius_m: Some(RADIUS),
+        interface_modes: None,
         full_reference: true,
     }
 }
@@ -239,4 +240,93 @@ fn travelling_attachment_is_continuous_across_stations() {
     assert!((mid.rows(3, 3) - (a.rows(3, 3) + b.rows(3, 3)) * 0.5).amax() < 1e-9 * scale);
     let nodes = body.attachment_nodes(2, 0.30);
     assert!((nodes.weights.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+}
+
+#[test]
+fn carriage_on_a_beam_deflects_like_the_beam_formula_and_moves_continuously() {
+    let (e, g, kappa) = (2.1e11, 8.1e10, 0.5);
+    let beam = fe_common::contract_beam(12, e, g);
+    let model = FeModel::beam(&beam).unwrap();
+    // A carriage 0.2 m off the beam axis (along x) travels along it; the foot node is held.
+    let atts = [
+        Attachment::fixed("foot", [0.0, 0.6, -0.1]),
+        Attachment::travel("carriage", [0.2, 0.6, -0.1], [0.2, 0.6, 1.1]),
+    ];
+    let body = reduce(
+        &model,
+        &atts,
+        &ReductionSettings {
+            modes: 8,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let w = body.width();
+    let foot = DMatrix::from_iterator(6, w, body.point_motion(0, 0.0).iter().copied());
+    let p = 1.0e4;
+    let force = DVector::from_row_slice(&[0.0, p, 0.0, 0.0, 0.0, 0.0]);
+    // On a node (s = 0.7 m: 0.7 m from the foot) the deflection along y is bending about local y
+    // (machine y is the section's local z) plus shear plus the twist from the 0.2 m lever.
+    let a = 0.7;
+    let g_p = DMatrix::from_iterator(6, w, body.point_motion(1, a).iter().copied());
+    let u = &g_p
+        * held_solve(
+            &body.stiffness_matrix(1.0),
+            &foot,
+            &(g_p.transpose() * &force),
+        );
+    let expected = p * a.powi(3) / (3.0 * e * beam.iy_m4)
+        + p * a / (kappa * g * beam.area_m2)
+        + 0.04 * p * a / (g * beam.torsion_m4);
+    assert!(
+        (u[1] - expected).abs() <= 1e-9 * expected,
+        "{} vs {expected}",
+        u[1]
+    );
+    // Stations are the beam's nodes (0.1 m apart): no step across any of them.
+    let scale = body.point_motion(1, 0.55).amax();
+    for k in 1..12 {
+        let s = 0.1 * k as f64;
+        let jump = (body.point_motion(1, s + 1e-9) - body.point_motion(1, s - 1e-9)).amax();
+        assert!(jump <= 1e-6 * scale, "step {jump:.2e} at s = {s}");
+    }
+    let at = body.attachment_nodes(1, 0.25);
+    assert_eq!(at.nodes, vec![3, 4]);
+    assert!((at.weights[0] - 0.5).abs() < 1e-12 && (at.weights[1] - 0.5).abs() < 1e-12);
+}
+
+#[test]
+fn reduced_interface_keeps_the_low_modes() {
+    // The rail's 9 stations and the two points: 66 interface DOFs, reduced to 6 + 12.
+    let model = FeModel::hex8_block(&block(2.1e11)).unwrap();
+    let full = generalized_eigenvalues(&dense(&model.stiffness), &dense(&model.mass));
+    let cutoff = 5000.0;
+    let settings = ReductionSettings {
+        interface_modes: Some(12),
+        full_reference: false,
+        ..settings(Some(cutoff))
+    };
+    let body = reduce(&model, &attachments(), &settings).unwrap();
+    assert_eq!(
+        (body.interface_dofs(), body.interface_coordinates()),
+        (66, 18)
+    );
+    let mut compared = 0;
+    for (r, l) in body.frequencies_hz(1.0).iter().zip(&full[6..]) {
+        let f = hz(*l);
+        assert!(*r >= f * (1.0 - 1e-9), "{r} below {f}");
+        if f < 0.5 * cutoff {
+            assert!((r - f) / f <= 1e-3, "{r} vs {f}");
+            compared += 1;
+        }
+    }
+    assert!(compared >= 6);
+    // Rigid-body motion is still exact at every station.
+    let g = body.point_motion(2, 0.5);
+    let d = attachments()[2].point_at(0.5) - body.mass.cog_m;
+    let mut rigid = DMatrix::<f64>::identity(6, 6);
+    rigid
+        .view_mut((0, 3), (3, 3))
+        .copy_from(&(-d.cross_matrix()));
+    assert!((g.columns(0, 6) - &rigid).amax() < 1e-9);
 }

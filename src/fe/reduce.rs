@@ -42,18 +42,25 @@ pub struct ReductionSettings {
     pub cutoff_hz: Option<f64>,
     /// RBE3 radius on solid (3-DOF) nodes, m (CONTRACT `attach_radius_m`).
     pub attach_radius_m: Option<f64>,
+    /// Reduce the interface to the six rigid-body motions plus this many characteristic
+    /// constraint modes (the lowest modes of the interface's Guyan model), where the stations
+    /// carry more DOFs than that (a rail of many stations on a solid). Static loads at the
+    /// stations are then no longer exact: [`ReducedBody::full_free_frequencies_hz`] and docs/fe.md
+    /// show the error.
+    pub interface_modes: Option<usize>,
     /// Also compute the full model's free-free frequencies for comparison (a second sparse
     /// eigensolution of the whole model: for small and medium models).
     pub full_reference: bool,
 }
 
 impl Default for ReductionSettings {
-    /// 20 modes, no radius, no full-model reference.
+    /// 20 modes, no radius, no interface reduction, no full-model reference.
     fn default() -> Self {
         ReductionSettings {
             modes: 20,
             cutoff_hz: None,
             attach_radius_m: None,
+            interface_modes: None,
             full_reference: false,
         }
     }
@@ -238,19 +245,41 @@ pub fn reduce(
     }
     drop(back);
 
-    let mut t = Mat::zeros(n, nb + m);
-    t.as_mut().subcols_mut(0, nb).copy_from(&psi);
-    t.as_mut().subcols_mut(nb, m).copy_from(&phi.vectors);
+    // Interface reduction: the station motions q = V ξ, V = [W R, lowest characteristic
+    // constraint modes of (ΨᵀKΨ, ΨᵀMΨ) beside the rigid-body motions].
+    let v = match settings.interface_modes {
+        Some(k) if 6 + k < nb => {
+            let kb = sandwich(&model.stiffness, psi.as_ref());
+            let mb = sandwich(&model.mass, psi.as_ref());
+            let (_, cc) = complement_modes(model, mb.as_ref(), kb.as_ref(), wr.as_ref())?;
+            let mut v = Mat::zeros(nb, 6 + k);
+            v.as_mut().subcols_mut(0, 6).copy_from(&wr);
+            v.as_mut().subcols_mut(6, k).copy_from(cc.subcols(0, k));
+            v
+        }
+        _ => Mat::identity(nb, nb),
+    };
+    let c = v.ncols();
+    let mut t = Mat::zeros(n, c + m);
+    t.as_mut().subcols_mut(0, c).copy_from(&psi * &v);
+    t.as_mut().subcols_mut(c, m).copy_from(&phi.vectors);
     drop(psi);
     let mr = sandwich(&model.mass, t.as_ref());
     let kr = sandwich(&model.stiffness, t.as_ref());
     drop(t);
-    let size = nb + m;
-    let mut xr = Mat::zeros(size, 6);
-    xr.as_mut().subrows_mut(0, nb).copy_from(&wr);
+    // The rigid-body motions in CB coordinates: ξ with V ξ = W R.
+    let mut xr = Mat::zeros(c + m, 6);
+    if c == nb {
+        xr.as_mut().subrows_mut(0, nb).copy_from(&wr);
+    } else {
+        xr.as_mut()
+            .subrows_mut(0, 6)
+            .copy_from(Mat::<f64>::identity(6, 6));
+    }
     let basis = body_basis(model, mr.as_ref(), kr.as_ref(), xr.as_ref())?;
+    let stations_q = &v * basis.vectors.subrows(0, c);
     let station_motion = (0..stations.len())
-        .map(|j| Matrix6xX::from_fn(basis.vectors.ncols(), |r, c| basis.vectors[(6 * j + r, c)]))
+        .map(|j| Matrix6xX::from_fn(stations_q.ncols(), |r, col| stations_q[(6 * j + r, col)]))
         .collect();
     let reduction_s = start.elapsed().as_secs_f64();
 
@@ -353,9 +382,29 @@ fn body_basis(
             format!("rigid-body motion of the reduced body produces elastic forces ({force:.1e}): fewer than 6 rigid-body modes"),
         ));
     }
+    let (lambda, xe) = complement_modes(model, mr, kr, xr)?;
+    let mut vectors = Mat::zeros(size, size);
+    vectors.as_mut().subcols_mut(0, 6).copy_from(xr);
+    vectors.as_mut().subcols_mut(6, size - 6).copy_from(&xe);
+    Ok(Basis {
+        eigenvalues: lambda,
+        vectors,
+    })
+}
+
+/// The modes of (K_r, M_r) in the M_r-orthogonal complement of the columns of `xr`: ω²
+/// ascending (all positive, else a mechanism) and the mass-normalised vectors.
+fn complement_modes(
+    model: &FeModel,
+    mr: MatRef<'_, f64>,
+    kr: MatRef<'_, f64>,
+    xr: MatRef<'_, f64>,
+) -> Result<(Vec<f64>, Mat<f64>), FeError> {
+    let size = mr.nrows();
+    let fixed = xr.ncols();
     let mx = mr * xr;
     let full_q = mx.qr().compute_Q();
-    let q2 = full_q.subcols(6, size - 6);
+    let q2 = full_q.subcols(fixed, size - fixed);
     let ke = q2.transpose() * kr * q2;
     let me = q2.transpose() * mr * q2;
     let ke = (&ke + ke.transpose()) * faer::Scale(0.5);
@@ -376,7 +425,7 @@ fn body_basis(
     let evd = a
         .self_adjoint_eigen(Side::Lower)
         .map_err(|_| fail(model, "the reduced eigenproblem did not converge"))?;
-    let lambda: Vec<f64> = (0..size - 6).map(|i| evd.S()[i]).collect();
+    let lambda: Vec<f64> = (0..size - fixed).map(|i| evd.S()[i]).collect();
     let top = lambda.iter().fold(0.0f64, |x, &v| x.max(v.abs()));
     if lambda.first().is_some_and(|&l| !(l > 1e-12 * top)) {
         return Err(fail(
@@ -395,13 +444,7 @@ fn body_basis(
         faer::Par::Seq,
     );
     let xe = q2 * &v;
-    let mut vectors = Mat::zeros(size, size);
-    vectors.as_mut().subcols_mut(0, 6).copy_from(xr);
-    vectors.as_mut().subcols_mut(6, size - 6).copy_from(&xe);
-    Ok(Basis {
-        eigenvalues: lambda,
-        vectors,
-    })
+    Ok((lambda, xe))
 }
 
 /// T(d): a station's motion (u, θ) carried to a point at offset d: (u + θ × d, θ).
@@ -426,6 +469,12 @@ impl ReducedBody {
     /// Interface DOFs: 6 per station.
     pub fn interface_dofs(&self) -> usize {
         6 * self.stations.len()
+    }
+
+    /// Interface coordinates kept: the interface DOFs, or 6 + `interface_modes` where the
+    /// interface was reduced.
+    pub fn interface_coordinates(&self) -> usize {
+        self.width() - self.fixed_interface_eigenvalues.len()
     }
 
     /// Elastic free-free frequencies at stiffness factor `c`, Hz: √(c ω²)/2π.

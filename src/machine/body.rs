@@ -81,6 +81,10 @@ pub trait ElasticModel: fmt::Debug + Send + Sync {
     /// when it lies at `point_m` (reference frame of the body, m); `None` if nothing of that
     /// kind attaches to the body.
     fn point_motion(&self, site: Site, point_m: &Vector3<f64>) -> Option<DMatrix<f64>>;
+    /// The model as [`std::any::Any`], so a caller can reach the concrete type behind it (e.g.
+    /// the reduced FE model of `[body.fe]`/`[body.beam]`, `machine::elastic::FeBody`) without
+    /// this module knowing that type (no import circle).
+    fn as_any(&self) -> &dyn std::any::Any;
 }
 
 /// An elastic body: its reduced model (shared, computed once per run) with the factor on its

@@ -8,6 +8,7 @@
 mod attach;
 pub mod body;
 pub mod catalogue;
+pub mod elastic;
 pub mod raw;
 pub mod stiffness;
 mod validate;
@@ -396,8 +397,9 @@ impl Machine {
         Machine::from_raw(raw, &Catalogue::bundled()?, file)
     }
 
-    /// The raw description with the current reduction factors and damping written back, e.g.
-    /// for exporting an identified machine.
+    /// The raw description with the current reduction factors, damping and body stiffness
+    /// factors written back, e.g. for exporting an identified machine (FE files by their
+    /// absolute paths, so that the exported file finds them from wherever it is written).
     pub fn to_raw(&self) -> RawMachine {
         let mut raw = self.raw.clone();
         for (ra, a) in raw.axes.iter_mut().zip(&self.axes) {
@@ -406,6 +408,16 @@ impl Machine {
             ra.guideway.damping_normal_n_s_per_m = a.guideway.damping_normal_n_s_per_m;
             ra.guideway.damping_lateral_n_s_per_m = a.guideway.damping_lateral_n_s_per_m;
             ra.drive.reduction = a.drive.reduction;
+        }
+        for (rb, b) in raw.bodies.iter_mut().zip(&self.bodies) {
+            if let Some(e) = b.elastic() {
+                if let Some(fe) = rb.fe.as_mut() {
+                    fe.stiffness_factor = e.stiffness_factor();
+                }
+                if let Some(beam) = rb.beam.as_mut() {
+                    beam.stiffness_factor = e.stiffness_factor();
+                }
+            }
         }
         raw
     }

@@ -92,6 +92,88 @@ pub struct RawBody {
     /// Inertia tensor about the centre of gravity in machine axes, kg·m².
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub inertia_kg_m2: Option<[[f64; 3]; 3]>,
+    /// An elastic body from an FE model an FE program exported.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fe: Option<RawFe>,
+    /// An elastic body eij builds as a Timoshenko beam.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub beam: Option<RawBeam>,
+}
+
+fn default_damping_ratio() -> f64 {
+    0.02
+}
+
+/// `[body.fe]`: an FE model as exported (CONTRACT "Flexible bodies"). Files are relative to the
+/// machine file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawFe {
+    /// Matrix Market mass matrix (`coordinate real symmetric` or `general`, 1-based, SI).
+    pub mass_matrix: String,
+    /// Matrix Market stiffness matrix.
+    pub stiffness_matrix: String,
+    /// `node,dof` per matrix row, in row order.
+    pub dofs: String,
+    /// `node,x_m,y_m,z_m`: machine coordinates at the reference position.
+    pub nodes: String,
+    /// Fixed-interface modes kept (default 20 where `cutoff_hz` is not given).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub modes: Option<usize>,
+    /// Resolve the body's modes up to this frequency instead, Hz.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cutoff_hz: Option<f64>,
+    /// Modal damping ratio of the elastic modes (0.02).
+    #[serde(default = "default_damping_ratio")]
+    pub damping_ratio: f64,
+    /// Factor on the whole elastic stiffness (E and G alike); identification writes it.
+    #[serde(default = "one", skip_serializing_if = "is_one")]
+    pub stiffness_factor: f64,
+    /// RBE3 radius on solid (3-DOF) nodes, m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub attach_radius_m: Option<f64>,
+}
+
+/// `[body.beam]`: a straight 3D Timoshenko beam eij builds (6 DOF per node).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawBeam {
+    /// Start point, m.
+    pub from_m: [f64; 3],
+    /// End point, m.
+    pub to_m: [f64; 3],
+    /// Number of elements.
+    pub elements: usize,
+    /// The section's local y direction.
+    pub y_axis: [f64; 3],
+    /// Section area, m².
+    pub area_m2: f64,
+    /// Second moment of area about local y, m⁴.
+    pub iy_m4: f64,
+    /// Second moment of area about local z, m⁴.
+    pub iz_m4: f64,
+    /// Torsion constant, m⁴.
+    pub torsion_m4: f64,
+    /// Shear area / area.
+    pub shear_factor: f64,
+    /// Young's modulus, Pa.
+    pub youngs_modulus_pa: f64,
+    /// Shear modulus, Pa.
+    pub shear_modulus_pa: f64,
+    /// Density, kg/m³.
+    pub density_kg_m3: f64,
+    /// Fixed-interface modes kept (default 20 where `cutoff_hz` is not given).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub modes: Option<usize>,
+    /// Resolve the body's modes up to this frequency instead, Hz.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cutoff_hz: Option<f64>,
+    /// Modal damping ratio of the elastic modes (0.02).
+    #[serde(default = "default_damping_ratio")]
+    pub damping_ratio: f64,
+    /// Factor on the whole elastic stiffness (E and G alike); identification writes it.
+    #[serde(default = "one", skip_serializing_if = "is_one")]
+    pub stiffness_factor: f64,
 }
 
 /// A linear axis: the moving body runs on guideways of the carrier body, driven by a ball screw.

@@ -77,6 +77,26 @@ impl Machine {
             }
             let cog = b.cog_m.unwrap_or([0.0; 3]);
             coords(&cog).map_err(|m| err(key("cog_m"), m))?;
+            let elastic = b.fe.is_some() || b.beam.is_some();
+            if b.fixed && elastic {
+                let which = if b.fe.is_some() { "fe" } else { "beam" };
+                return Err(err(
+                    key(which),
+                    "a fixed body cannot be elastic (it has no coordinates)".into(),
+                ));
+            }
+            if elastic {
+                // Mass properties come from the FE model (with_elastic_bodies below), checked
+                // against these where they are given.
+                bodies.push(Body {
+                    name: b.name.clone(),
+                    mass_kg: b.mass_kg.unwrap_or(0.0),
+                    cog_m: Vector3::from(cog),
+                    inertia_kg_m2: Matrix3::zeros(),
+                    kind: BodyKind::Rigid,
+                });
+                continue;
+            }
             if b.fixed {
                 bodies.push(Body {
                     name: b.name.clone(),
@@ -328,7 +348,8 @@ impl Machine {
             });
         }
 
-        Ok(Machine {
+        let raw_bodies = raw.bodies.clone();
+        Machine {
             name: raw.name.clone(),
             source: file.to_string(),
             rayleigh_beta_s: raw.rayleigh_beta_s,
@@ -339,7 +360,8 @@ impl Machine {
             joints,
             moved_by,
             raw,
-        })
+        }
+        .with_elastic_bodies(&raw_bodies)
     }
 }
 

@@ -74,6 +74,29 @@ pub fn whole_machine_motion(
     v
 }
 
+/// Asserts that the motion `v` (m, rad) is free: no spring force (relative 1e-12), no
+/// deviation at the R-Test and no scale reading (below `tol_m`).
+pub fn assert_motion_free(model: &Model, v: &nalgebra::DVector<f64>, tol_m: f64) {
+    let force = (&model.stiffness * v).norm();
+    assert!(
+        force < 1e-12 * model.stiffness.norm() * v.norm(),
+        "{force} N"
+    );
+    assert!((&model.tcp * v).norm() < tol_m, "a deviation");
+    for p in &model.axes {
+        assert!(p.scale.dot(v).abs() < tol_m, "a scale reading");
+    }
+}
+
+/// The simulated EIJ of one test on one machine (harmonic, default settings).
+pub fn one_eij(machine: &Machine, test: eij::predict::CircleTest) -> eij::predict::EijMap {
+    let settings = eij::predict::SimSettings::default();
+    eij::predict::simulated_eij(std::slice::from_ref(machine), &[test], &settings)
+        .unwrap()
+        .remove(0)
+        .remove(0)
+}
+
 /// A scratch folder, emptied on creation and removed on drop.
 pub struct Scratch(pub PathBuf);
 

@@ -66,3 +66,22 @@ pub fn held_eigenvalues(k: &DMatrix<f64>, m: &DMatrix<f64>) -> Vec<f64> {
     e.sort_by(|x, y| x.total_cmp(y));
     e
 }
+
+/// The `[body.beam]` of CONTRACT's example (a column along z) with `elements` elements and the
+/// given E and G.
+pub fn contract_beam(elements: usize, e: f64, g: f64) -> eij::fe::Beam {
+    eij::fe::Beam {
+        from_m: [0.0, 0.6, -0.1],
+        to_m: [0.0, 0.6, 1.1],
+        elements,
+        y_axis: [1.0, 0.0, 0.0],
+        area_m2: 0.05,
+        iy_m4: 1.0e-3,
+        iz_m4: 1.2e-3,
+        torsion_m4: 1.5e-3,
+        shear_factor: 0.5,
+        youngs_modulus_pa: e,
+        shear_modulus_pa: g,
+        density_kg_m3: 7200.0,
+    }
+}
