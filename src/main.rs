@@ -61,6 +61,10 @@ fn main() -> std::process::ExitCode {
     let result = cli.run();
     let printed = cli::console::finish();
     match (result, printed) {
+        (Err(e), _) if e.is::<cli::evaluate_diagnosis::OutOfTolerance>() => {
+            errln!("eij: {e}");
+            std::process::ExitCode::from(cli::evaluate_diagnosis::EXIT_CODE)
+        }
         (Err(e), _) => {
             let line = eij::text::compact_numbers(&format!("{e:#}").replace('\n', " "));
             errln!("eij: error: {line}");

@@ -1,10 +1,11 @@
 //! `eij evaluate PATH... [--plane xy|yz|zx] [--radius-mm R] [--json] [--csv-out FILE]
-//! [--pooled] [--fit-time-offset]`
+//! [--pooled] [--fit-time-offset] [--diagnose [--cyclic-pitch-mm P] [--spike-decay-ms T]]`
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use eij::axes::Plane;
+use eij::measured::conditions::DiagnosisSettings;
 use eij::measured::inputs::expand_tests;
 use eij::measured::suite::{self, EvaluatedTest, Suite, SuiteOptions};
 use eij::measured::table;
@@ -42,6 +43,20 @@ pub struct EvaluateArgs {
     /// aligned.
     #[arg(long)]
     pub fit_time_offset: bool,
+    /// Also break every circle down into named errors (backlash, servo mismatch, squareness,
+    /// …) per source — the axes, the structure (external − internal) and the TCP — ranked by
+    /// their share of G and judged against the folder's `[tolerances]` (docs/diagnosis.md);
+    /// a test out of tolerance makes the exit code 3.
+    #[arg(long)]
+    pub diagnose: bool,
+    /// Pitch of the cyclic error fitted by --diagnose (screw lead, scale period), mm
+    /// (default: `rtest.toml` `[diagnosis]`, else no cyclic terms).
+    #[arg(long, value_name = "MM", requires = "diagnose")]
+    pub cyclic_pitch_mm: Option<f64>,
+    /// Decay time of the reversal spikes fitted by --diagnose, ms (default: `rtest.toml`
+    /// `[diagnosis]`, else 10).
+    #[arg(long, value_name = "MS", requires = "diagnose")]
+    pub spike_decay_ms: Option<f64>,
 }
 
 /// Runs `eij evaluate`.
@@ -53,6 +68,14 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<()> {
         if r > 3.0 {
             anyhow::bail!("--radius-mm: {r} mm exceeds the R-Test probe range of ±3 mm");
         }
+    }
+    let settings = DiagnosisSettings {
+        cyclic_pitch_mm: args.cyclic_pitch_mm,
+        cyclic_harmonics: None,
+        spike_decay_ms: args.spike_decay_ms,
+    };
+    if let Err((key, message)) = settings.check() {
+        anyhow::bail!("--{}: {message}", key.replace('_', "-"));
     }
     if args.plot.is_some() && args.files.len() != 1 {
         anyhow::bail!(
@@ -91,6 +114,11 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<()> {
     let spinner =
         super::console::Progress::spinner(&format!("evaluate: {} circle test(s)", tests.len()));
     let suite = suite::evaluate_tests(&tests, &opts).map_err(super::advice::evaluate)?;
+    let diagnosis = if args.diagnose {
+        Some(suite::diagnose::diagnose(&suite, settings).map_err(super::advice::evaluate)?)
+    } else {
+        None
+    };
     drop(spinner);
     let pooled = if args.pooled {
         let refs: Vec<&CircleSeries> = suite.tests.iter().map(|t| &t.series).collect();
@@ -154,18 +182,37 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<()> {
     for w in &suite.warnings {
         errln!("eij: warning: {w}");
     }
+    if let Some(d) = &diagnosis {
+        for (t, v) in suite.tests.iter().zip(&d.verdicts) {
+            for u in v.iter().flat_map(|v| &v.unchecked) {
+                errln!(
+                    "eij: warning: {}: tolerance {u}: not measured in this test",
+                    t.input.name()
+                );
+            }
+        }
+    }
     if args.json {
         let mut doc = suite.to_json_map();
         if let Some(p) = &pooled {
             doc.insert("pooled".into(), p.to_json());
         }
+        if let Some(d) = &diagnosis {
+            d.add_to_json(&mut doc);
+        }
         outln!("{}", serde_json::Value::Object(doc));
     } else {
         let mut text = String::new();
-        for t in &suite.tests {
+        for (i, t) in suite.tests.iter().enumerate() {
             render_result(&mut text, t);
+            if let Some(d) = &diagnosis {
+                super::evaluate_diagnosis::render_test(&mut text, d, i);
+            }
         }
         render_suite(&mut text, &suite);
+        if let Some(d) = &diagnosis {
+            super::evaluate_diagnosis::render_groups(&mut text, d);
+        }
         if let Some(p) = &pooled {
             render_pooled(&mut text, p);
         }
@@ -175,7 +222,13 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<()> {
         let written: Vec<&Path> = files.iter().map(|(p, _)| *p).collect();
         super::console::wrote(&written);
     }
-    Ok(())
+    match diagnosis
+        .as_ref()
+        .and_then(super::evaluate_diagnosis::OutOfTolerance::of)
+    {
+        Some(fail) => Err(fail.into()),
+        None => Ok(()),
+    }
 }
 
 fn render_result(out: &mut String, t: &EvaluatedTest) {
@@ -270,17 +323,21 @@ fn render_suite(out: &mut String, suite: &Suite) {
     }
 }
 
+/// Accelerations as `2.000, 5.000` (m/s²).
+pub(super) fn accelerations(a: &[f64]) -> String {
+    a.iter()
+        .map(|a| format!("{a:.3}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 fn render_pooled(out: &mut String, p: &PooledResult) {
     let _ = writeln!(
         out,
         "pooled over {} tests, plane {}, accelerations {} m/s²",
         p.sources.len(),
         p.plane,
-        p.accel_m_s2
-            .iter()
-            .map(|a| format!("{a:.3}"))
-            .collect::<Vec<_>>()
-            .join(", ")
+        accelerations(&p.accel_m_s2)
     );
     let _ = writeln!(
         out,

@@ -30,6 +30,7 @@ mod advice;
 mod compensation;
 pub mod console;
 pub mod evaluate;
+pub mod evaluate_diagnosis;
 mod evaluate_move;
 mod export;
 mod identify;

@@ -2,11 +2,14 @@
 //! folder in `rtest.toml` (docs/measurement-files.md): the set radius and circle-centre
 //! position, how the files name their columns and in which unit (`[columns]`), and per-test
 //! entries (`[[test]]`) with their own conditions, including tests recorded by two systems
-//! (an `internal` and an `external` file with their own clocks).
+//! (an `internal` and an `external` file with their own clocks); the tolerances the tests are
+//! judged against (`[tolerances]`) and the settings of their diagnosis (`[diagnosis]`).
 
 use super::error::MeasuredError;
 use super::layout::{ColumnEntry, ColumnMap};
 use crate::axes::{Direction, Plane};
+use crate::rtest::diagnosis::tolerance::Tolerances;
+use crate::rtest::diagnosis::DiagnosisOptions;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -33,8 +36,70 @@ pub struct TestConditions {
     pub external_columns: ColumnMap,
     /// The `[[test]]` entries, in file order.
     pub tests: Vec<TestEntry>,
+    /// Limits on G and on the diagnosis' terms (`[tolerances]`, docs/diagnosis.md).
+    pub tolerances: Tolerances,
+    /// Settings of the diagnosis (`[diagnosis]`).
+    pub diagnosis: DiagnosisSettings,
     /// The `rtest.toml` these conditions come from, if any.
     pub file: Option<PathBuf>,
+}
+
+/// `[diagnosis]` of `rtest.toml`: what the circle diagnosis needs to know about the machine;
+/// absent keys take [`DiagnosisOptions`]' defaults.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DiagnosisSettings {
+    /// Pitch of the cyclic error (screw lead, scale period), mm.
+    pub cyclic_pitch_mm: Option<f64>,
+    /// Harmonics of the pitch fitted, 1 to 5.
+    pub cyclic_harmonics: Option<usize>,
+    /// Decay time of a reversal spike, ms.
+    pub spike_decay_ms: Option<f64>,
+}
+
+impl DiagnosisSettings {
+    /// These settings over `self`'s unset keys `under` (e.g. the command line's over a
+    /// folder's).
+    pub fn over(self, under: DiagnosisSettings) -> DiagnosisSettings {
+        DiagnosisSettings {
+            cyclic_pitch_mm: self.cyclic_pitch_mm.or(under.cyclic_pitch_mm),
+            cyclic_harmonics: self.cyclic_harmonics.or(under.cyclic_harmonics),
+            spike_decay_ms: self.spike_decay_ms.or(under.spike_decay_ms),
+        }
+    }
+
+    /// The options of the diagnosis, defaults where unset.
+    pub fn options(self) -> DiagnosisOptions {
+        let d = DiagnosisOptions::default();
+        DiagnosisOptions {
+            cyclic_pitch_mm: self.cyclic_pitch_mm,
+            cyclic_harmonics: self.cyclic_harmonics.unwrap_or(d.cyclic_harmonics),
+            spike_decay_ms: self.spike_decay_ms.unwrap_or(d.spike_decay_ms),
+        }
+    }
+
+    /// Checks the values; the error names the key (`cyclic_pitch_mm`, …).
+    pub fn check(&self) -> Result<(), (&'static str, String)> {
+        let positive = |v: Option<f64>, key: &'static str, max: f64| match v {
+            Some(x) if !(x.is_finite() && x > 0.0 && x <= max) => Err((
+                key,
+                format!(
+                    "{} must lie in (0, {}]",
+                    crate::text::num(x),
+                    crate::text::num(max)
+                ),
+            )),
+            _ => Ok(()),
+        };
+        positive(self.cyclic_pitch_mm, "cyclic_pitch_mm", 1e3)?;
+        positive(self.spike_decay_ms, "spike_decay_ms", 1e3)?;
+        match self.cyclic_harmonics {
+            Some(h) if !(1..=5).contains(&h) => {
+                Err(("cyclic_harmonics", format!("{h} must lie in 1 to 5")))
+            }
+            _ => Ok(()),
+        }
+    }
 }
 
 /// What a test's data are: one file with both measurements, or one file per measuring system.
@@ -89,6 +154,8 @@ struct RawConditions {
     external_columns: Option<BTreeMap<String, ColumnEntry>>,
     #[serde(default)]
     test: Vec<RawTest>,
+    tolerances: Option<toml::Table>,
+    diagnosis: Option<DiagnosisSettings>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -185,6 +252,14 @@ impl TestConditions {
         for (i, t) in raw.test.into_iter().enumerate() {
             tests.push(test_entry(i + 1, t, &bad)?);
         }
+        let tolerances = match &raw.tolerances {
+            Some(t) => Tolerances::from_toml(t).map_err(|e| bad(&e.key, e.message))?,
+            None => Tolerances::default(),
+        };
+        let diagnosis = raw.diagnosis.unwrap_or_default();
+        diagnosis
+            .check()
+            .map_err(|(key, m)| bad(&format!("diagnosis.{key}"), m))?;
         Ok(TestConditions {
             radius_mm: raw.radius_mm,
             position_mm: raw.position_mm,
@@ -192,6 +267,8 @@ impl TestConditions {
             internal_columns,
             external_columns,
             tests,
+            tolerances,
+            diagnosis,
             file: None,
         })
     }

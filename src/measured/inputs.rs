@@ -5,11 +5,14 @@
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
-use super::conditions::{folder_of, Recording, TestConditions, TestEntry, MAX_TESTS};
+use super::conditions::{
+    folder_of, DiagnosisSettings, Recording, TestConditions, TestEntry, MAX_TESTS,
+};
 use super::error::MeasuredError;
 use super::layout::ColumnMap;
 use crate::axes::{Direction, Plane};
 use crate::io::FileId;
+use crate::rtest::diagnosis::tolerance::Tolerances;
 use crate::rtest::CircleSeries;
 
 /// One circle test to read and evaluate, with everything known about its conditions.
@@ -43,6 +46,10 @@ pub struct TestInput {
     pub internal_columns: ColumnMap,
     /// Column map of its external file.
     pub external_columns: ColumnMap,
+    /// The limits it is judged against (`[tolerances]`).
+    pub tolerances: Tolerances,
+    /// Settings of its diagnosis (`[diagnosis]`).
+    pub diagnosis: DiagnosisSettings,
 }
 
 impl TestInput {
@@ -102,6 +109,8 @@ impl TestInput {
             columns: cond.columns.clone(),
             internal_columns: cond.internal_columns.clone(),
             external_columns: cond.external_columns.clone(),
+            tolerances: cond.tolerances.clone(),
+            diagnosis: cond.diagnosis,
         }
     }
 

@@ -15,6 +15,7 @@ use crate::rtest::{evaluate, iso230, CircleResult, CircleSeries, EvalOptions};
 use rayon::prelude::*;
 
 mod clocks;
+pub mod diagnose;
 use clocks::{align_clock, lag_of_clock};
 pub use clocks::{clocks_json, ClockReport, OffsetSource, TimeOffset};
 

@@ -259,14 +259,15 @@ fn write_back(
     let Some(term) = sd.term_mut(&sep.name) else {
         return;
     };
+    let accels: Vec<String> = cond.accel.iter().map(|a| format!("{a:.2}")).collect();
     let slope_note = |what: &str| {
         sep.per_m_s2.map(|kappa| {
             format!(
                 "grows with acceleration, {kappa:.4} ± {:.4} {} per m/s² over the tests at \
-                 {:?} m/s² ({what}, not geometry); the part at no acceleration is {:.3} ± {:.3}",
+                 {} m/s²: not geometry but {what}; the part at no acceleration is {:.3} ± {:.3}",
                 sep.per_m_s2_std_err.unwrap_or(f64::NAN),
                 sep.unit,
-                cond.accel,
+                accels.join(", "),
                 sep.geometric,
                 sep.geometric_std_err
             )
@@ -274,7 +275,10 @@ fn write_back(
     };
     let what = match source {
         Source::Internal => "a dynamic control error",
-        Source::Structure | Source::Tcp => "EIJ",
+        Source::Structure => "EIJ",
+        Source::Tcp => {
+            "EIJ or a dynamic control error (the internal and the structure source tell which)"
+        }
     };
     if let (Some(dtau), Some(dtau_se)) = (sep.servo_mismatch_ms, sep.servo_mismatch_std_err_ms) {
         let apparent = term.value;
