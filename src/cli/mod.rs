@@ -33,6 +33,7 @@ pub mod evaluate;
 pub mod evaluate_diagnosis;
 mod evaluate_move;
 mod export;
+mod history;
 mod identify;
 mod identify_print;
 mod machine_args;
@@ -79,6 +80,8 @@ enum Command {
     Compensation(compensation::CompensationArgs),
     /// Write an offline HTML report with SVG figures (circle tests, moves, identification).
     Report(report::ReportArgs),
+    /// Line up dated evaluations of one machine: diagnosis terms and EIJ over time, drift.
+    History(history::HistoryArgs),
 }
 
 impl Cli {
@@ -97,6 +100,7 @@ impl Cli {
             Command::Verify(args) => identify::verify(args),
             Command::Map(args) => map::run(args),
             Command::Report(args) => report::run(args),
+            Command::History(args) => history::run(args),
             Command::Stiffness(args) => stiffness::run(args),
             Command::Compensation(args) => compensation::run(args),
         }
