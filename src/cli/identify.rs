@@ -212,14 +212,7 @@ fn prepare(
     } = measured::load_measured(measured_inputs, &mopts)?;
     let problem =
         Problem::new(machine, params, tests, settings).map_err(super::advice::identify)?;
-    let provenance = Provenance::now(
-        machine_path.display().to_string(),
-        measured_inputs
-            .data_files()
-            .iter()
-            .map(|p| p.display().to_string())
-            .collect(),
-    )?;
+    let provenance = Provenance::now(machine_path, measured_inputs.data_files())?;
     Ok(Prepared {
         problem,
         provenance,

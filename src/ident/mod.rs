@@ -87,6 +87,13 @@ pub struct Identified {
     pub at_bound: bool,
 }
 
+impl Identified {
+    /// How well the tests determine it ([`verdict::Standing`]: determined, loose, weak, …).
+    pub fn standing(&self) -> verdict::Standing {
+        verdict::Standing::of(self.value, self.std_err, self.identifiable, self.at_bound)
+    }
+}
+
 /// One fitted static term (see [`statics`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct StaticEstimate {
@@ -172,6 +179,12 @@ impl IdentResult {
             Some(e) => Err(e.clone()),
             None => Ok(self),
         }
+    }
+
+    /// The χ² test of the fit: whether the residual standard deviation s is compatible with 1
+    /// over the fit's degrees of freedom ([`verdict::Chi2`]).
+    pub fn chi2(&self) -> verdict::Chi2 {
+        verdict::Chi2::new(self.residual_std, self.degrees_of_freedom)
     }
 }
 
