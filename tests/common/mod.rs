@@ -37,6 +37,22 @@ pub fn demo() -> Machine {
     machine("demo-vmc.toml")
 }
 
+/// The demo machine's default parameters (guideway factors) identified from `tests`, without
+/// the ranking of candidate tests: the problem and its result.
+pub fn fit_demo(
+    tests: Vec<eij::ident::TestCase>,
+) -> (eij::ident::Problem, eij::ident::IdentResult) {
+    let base = demo();
+    let settings = eij::ident::Settings {
+        design: false,
+        ..Default::default()
+    };
+    let params = eij::ident::Parameter::default_set(&base);
+    let problem = eij::ident::Problem::new(base, params, tests, settings).unwrap();
+    let result = eij::ident::identify(&problem, None).unwrap();
+    (problem, result)
+}
+
 /// The demo machine file's text (for variations of it).
 pub fn demo_text() -> String {
     std::fs::read_to_string(root().join(DEMO)).unwrap()
