@@ -39,28 +39,47 @@
 //!
 //! [`Identification`] reads measured circle tests (CSV files, folders with `rtest.toml`, or EIJ
 //! tables), simulates the same tests on the model and fits stiffness reduction factors, with
-//! documented defaults for everything not given:
+//! documented defaults for everything not given (the six guideway factors, Levenberg–Marquardt,
+//! a set radius of 2 mm). The result says how far to trust it — the χ² test of the fit
+//! ([`Chi2`]) and each factor's [`Standing`] — and writes the identified machine file with its
+//! [`Provenance`] (what `eij identify` writes):
 //!
 //! ```
-//! use eij::{Identification, Machine};
+//! use eij::{Identification, Machine, Provenance};
 //! use std::path::Path;
 //!
 //! let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-//! let machine = Machine::from_file(&root.join("machines/demo-vmc.toml"))?;
-//! let demo = root.join("measurements/demo-vmc");
-//! let result = Identification::new(machine)
-//!     .parameters(["z.guideway_normal", "z.guideway_lateral"])
-//!     .measured([demo.join("pos-a/zx_ccw_5.csv"), demo.join("pos-a/zx_cw_8.csv"), demo.join("pos-b/zx_ccw_8.csv")])
+//! let machine_file = root.join("machines/demo-vmc.toml");
+//! let measured = [root.join("measurements/demo-vmc")];
+//! let result = Identification::new(Machine::from_file(&machine_file)?)
+//!     .measured(&measured)
 //!     .run()?;
+//!
+//! let chi2 = result.chi2();
+//! println!("χ² test {}", chi2.describe());
 //! for p in &result.parameters {
-//!     println!("{} = {:.3} ± {:.3}", p.name, p.value, p.std_err.unwrap_or(f64::NAN));
+//!     let se = p.std_err.unwrap_or(f64::NAN);
+//!     println!("{} = {:.3} ± {:.3} ({})", p.name, p.value, se, p.standing().label());
 //! }
 //! // measurements/demo-vmc was generated with the Z guideway's normal stiffness at 40 % of the
 //! // catalogue value (its README); the fit finds it within three standard errors.
-//! let z = &result.parameters[0];
+//! let z = result.parameters.iter().find(|p| p.name == "z.guideway_normal").unwrap();
 //! assert!((z.value - 0.40).abs() < 3.0 * z.std_err.unwrap());
+//! assert!(chi2.passed);
+//!
+//! let folder = std::env::temp_dir().join(format!("eij-doc-{}", std::process::id()));
+//! std::fs::create_dir_all(&folder)?;
+//! let identified = folder.join("demo-vmc-identified.toml");
+//! result.write_machine_file(&identified, &Provenance::now(&machine_file, &measured)?)?;
+//! assert_eq!(Machine::from_file(&identified)?.name(), "demo-vmc-identified");
+//! std::fs::remove_dir_all(&folder)?;
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
+//!
+//! Lower down: [`identify`] runs a prepared [`ident::Problem`] (with a progress callback),
+//! [`evaluate`] evaluates one R-Test series ([`CircleSeries`]) into EIJ, [`simulated_eij`]
+//! predicts the EIJ of circle tests ([`CircleTest`]) on a machine, [`ClosedLoop`] is the
+//! machine under control at a [`Pose`].
 //!
 //! ## Features
 //!
@@ -88,8 +107,13 @@ pub mod text;
 
 pub use axes::{Axis, Direction, Eij, Plane};
 pub use control::ClosedLoop;
-pub use ident::{IdentError, IdentResult, Identification, Method, Parameter, Settings, TestCase};
-pub use machine::{Machine, MachineError};
+pub use ident::report::{machine_toml, ExportError, Provenance};
+pub use ident::verdict::{Chi2, Standing};
+pub use ident::{
+    identify, IdentError, IdentResult, Identification, Identified, Method, Parameter, Settings,
+    TestCase,
+};
+pub use machine::{Machine, MachineError, Pose};
 pub use measured::MeasuredError;
 pub use predict::{simulated_eij, CircleTest, PredictError, SimSettings, SolverKind};
 pub use rtest::{evaluate, CircleResult, CircleSeries, EvalOptions, RtestError};

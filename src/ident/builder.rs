@@ -4,7 +4,7 @@ use super::measured::{self, MeasuredOptions};
 use super::{identify, IdentError, IdentResult, Method, Parameter, Problem, Settings, TestCase};
 use crate::machine::Machine;
 use crate::predict::SolverKind;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// An identification to run: a machine, measured tests and what to fit.
 ///
@@ -82,8 +82,9 @@ impl Identification {
 
     /// Adds measured inputs, read when the identification runs: R-Test CSV files, folders of
     /// them (with `rtest.toml`), or EIJ tables.
-    pub fn measured(mut self, paths: impl IntoIterator<Item = PathBuf>) -> Self {
-        self.measured.extend(paths);
+    pub fn measured<P: AsRef<Path>>(mut self, paths: impl IntoIterator<Item = P>) -> Self {
+        self.measured
+            .extend(paths.into_iter().map(|p| p.as_ref().to_path_buf()));
         self
     }
 

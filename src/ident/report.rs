@@ -13,6 +13,7 @@ use crate::machine::raw::{RawProvenance, RawProvenanceParameter};
 use crate::machine::stiffness::StiffnessRow;
 use serde::{Deserialize, Deserializer, Serialize};
 use std::collections::BTreeMap;
+use std::path::Path;
 
 /// Provenance written into exports: what produced them and when.
 #[derive(Debug, Clone, PartialEq)]
@@ -26,12 +27,19 @@ pub struct Provenance {
 }
 
 impl Provenance {
-    /// Provenance with the current (or SOURCE_DATE_EPOCH) time; an error where
-    /// SOURCE_DATE_EPOCH is set but is not a time ([`utc_timestamp`]).
-    pub fn now(machine_file: String, measured: Vec<String>) -> Result<Self, SourceDateError> {
+    /// Provenance of the machine file `machine_file` identified from `measured`, with the
+    /// current (or SOURCE_DATE_EPOCH) time; an error where SOURCE_DATE_EPOCH is set but is not
+    /// a time ([`utc_timestamp`]).
+    pub fn now<P: AsRef<Path>>(
+        machine_file: impl AsRef<Path>,
+        measured: impl IntoIterator<Item = P>,
+    ) -> Result<Self, SourceDateError> {
         Ok(Provenance {
-            machine_file,
-            measured,
+            machine_file: machine_file.as_ref().display().to_string(),
+            measured: measured
+                .into_iter()
+                .map(|p| p.as_ref().display().to_string())
+                .collect(),
             date: utc_timestamp()?,
         })
     }
@@ -549,58 +557,103 @@ impl IdentReport {
     }
 }
 
-/// The identified machine as TOML text: the machine file with the identified factors, a
-/// comment header and a `[provenance]` table saying from what and how it was identified.
+/// The identified machine as TOML text (see [`IdentResult::machine_toml`]); `problem` is the
+/// problem `result` was identified from.
 pub fn machine_toml(
     problem: &Problem,
     result: &IdentResult,
     prov: &Provenance,
 ) -> Result<String, toml::ser::Error> {
-    let mut raw = result.machine.to_raw();
-    raw.provenance = Some(RawProvenance {
-        cost_final: result.cost_final,
-        cost_initial: result.cost_initial,
-        date: prov.date.clone(),
-        from_machine: prov.machine_file.clone(),
-        identified_by: format!("eij {}", env!("CARGO_PKG_VERSION")),
-        measured: prov.measured.clone(),
-        parameters: result
-            .parameters
-            .iter()
-            .map(|q| {
-                let entry = RawProvenanceParameter {
-                    identifiable: q.identifiable,
-                    identified: q.value,
-                    initial: q.initial,
-                    std_err: q.std_err,
-                };
-                (q.name.clone(), entry)
-            })
-            .collect(),
-        tests: problem.tests().len(),
-    });
-    raw.name = format!("{}-identified", problem.machine().name());
-    let body = toml::to_string_pretty(&raw)?;
-    let mut header = format!(
-        "# Identified by eij {} on {} from {} and {} measured input(s).\n",
-        env!("CARGO_PKG_VERSION"),
-        prov.date,
-        prov.machine_file,
-        prov.measured.len()
-    );
-    header.push_str("# Stiffness = catalogue value × reduction factor; identified factors:\n");
-    for q in &result.parameters {
-        match q.std_err {
-            Some(s) => header.push_str(&format!(
-                "#   {} = {:.4} ± {:.4} (start {})\n",
-                q.name, q.value, s, q.initial
-            )),
-            None => header.push_str(&format!(
-                "#   {} = {} (not identifiable, unchanged)\n",
-                q.name, q.value
-            )),
+    debug_assert_eq!(problem.tests().len(), result.simulated_final.len());
+    result.machine_toml(prov)
+}
+
+/// Why an identified machine file was not written.
+#[derive(Debug, thiserror::Error)]
+pub enum ExportError {
+    /// The fit must not be exported ([`IdentResult::accepted`]): it did not converge or ended on
+    /// a bound.
+    #[error("the identification is not exported: {0}")]
+    Refused(#[source] Box<super::IdentError>),
+    /// The machine could not be written as TOML.
+    #[error("cannot write the identified machine: {0}")]
+    Toml(#[from] toml::ser::Error),
+    /// The file could not be written (the message names it).
+    #[error(transparent)]
+    Write(#[from] crate::io::WriteError),
+}
+
+impl IdentResult {
+    /// The identified machine as TOML text: the machine file with the identified factors, a
+    /// comment header and a `[provenance]` table saying from what and how it was identified
+    /// (what `eij identify --out` writes).
+    pub fn machine_toml(&self, prov: &Provenance) -> Result<String, toml::ser::Error> {
+        let mut raw = self.machine.to_raw();
+        raw.provenance = Some(RawProvenance {
+            cost_final: self.cost_final,
+            cost_initial: self.cost_initial,
+            date: prov.date.clone(),
+            from_machine: prov.machine_file.clone(),
+            identified_by: format!("eij {}", env!("CARGO_PKG_VERSION")),
+            measured: prov.measured.clone(),
+            parameters: self
+                .parameters
+                .iter()
+                .map(|q| {
+                    let entry = RawProvenanceParameter {
+                        identifiable: q.identifiable,
+                        identified: q.value,
+                        initial: q.initial,
+                        std_err: q.std_err,
+                    };
+                    (q.name.clone(), entry)
+                })
+                .collect(),
+            tests: self.simulated_final.len(),
+        });
+        raw.name = format!("{}-identified", self.machine.name());
+        let body = toml::to_string_pretty(&raw)?;
+        let mut header = format!(
+            "# Identified by eij {} on {} from {} and {} measured input(s).\n",
+            env!("CARGO_PKG_VERSION"),
+            prov.date,
+            prov.machine_file,
+            prov.measured.len()
+        );
+        header.push_str("# Stiffness = catalogue value × reduction factor; identified factors:\n");
+        for q in &self.parameters {
+            match q.std_err {
+                Some(s) => header.push_str(&format!(
+                    "#   {} = {:.4} ± {:.4} (start {})\n",
+                    q.name, q.value, s, q.initial
+                )),
+                None => header.push_str(&format!(
+                    "#   {} = {} (not identifiable, unchanged)\n",
+                    q.name, q.value
+                )),
+            }
         }
+        header.push('\n');
+        Ok(header + &body)
     }
-    header.push('\n');
-    Ok(header + &body)
+
+    /// Writes the identified machine file ([`IdentResult::machine_toml`]) to `path`, atomically
+    /// and never over one of the measured inputs named in `prov` ([`crate::io::write_atomic`]);
+    /// a fit that must not be exported ([`IdentResult::refusal`]) is refused.
+    pub fn write_machine_file(
+        &self,
+        path: impl AsRef<Path>,
+        prov: &Provenance,
+    ) -> Result<(), ExportError> {
+        if let Some(refusal) = &self.refusal {
+            return Err(ExportError::Refused(Box::new(refusal.clone())));
+        }
+        let text = self.machine_toml(prov)?;
+        let inputs: Vec<&Path> = std::iter::once(&prov.machine_file)
+            .chain(&prov.measured)
+            .map(Path::new)
+            .collect();
+        crate::io::write_atomic(path.as_ref(), text.as_bytes(), &inputs)?;
+        Ok(())
+    }
 }
