@@ -7,6 +7,7 @@
 
 mod common;
 
+use common::diagnosis_checks::within;
 use common::diagnosis_demo::{self as demo, BACKLASH_UM, EIJ};
 use common::{eij, root};
 use serde_json::Value;
@@ -35,13 +36,6 @@ fn term(test: &Value, source: &str, name: &str) -> (f64, f64) {
         .find(|t| t["name"] == name)
         .unwrap_or_else(|| panic!("{source} {name}"));
     (t["value"].as_f64().unwrap(), t["std_err"].as_f64().unwrap())
-}
-
-fn within(what: &str, (v, se): (f64, f64), truth: f64, k: f64) {
-    assert!(
-        (v - truth).abs() < k * se,
-        "{what}: {v:.4} ± {se:.4}, truth {truth}"
-    );
 }
 
 #[test]

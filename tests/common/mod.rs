@@ -4,6 +4,7 @@
 #![allow(dead_code)]
 
 pub mod circle_terms;
+pub mod diagnosis_checks;
 pub mod diagnosis_demo;
 pub mod imperfect;
 pub mod mutation;
