@@ -51,6 +51,45 @@ impl FeModel {
     }
 }
 
+/// Where the four files of an exported FE model go (see [`FeModel::from_files`]).
+#[derive(Debug, Clone, Copy)]
+pub struct FePaths<'a> {
+    /// Matrix Market mass matrix.
+    pub mass: &'a Path,
+    /// Matrix Market stiffness matrix.
+    pub stiffness: &'a Path,
+    /// DOF map `node,dof`.
+    pub dofs: &'a Path,
+    /// Nodes `node,x_m,y_m,z_m`.
+    pub nodes: &'a Path,
+}
+
+impl FeModel {
+    /// Writes the model as an FE program exports it, the files [`FeModel::from_files`] reads:
+    /// M and K as `coordinate real symmetric` Matrix Market (17 digits, `comment` in their
+    /// header), the DOF map in row order and the nodes (shortest round-trip decimals).
+    pub fn write_files(&self, to: FePaths, comment: &str) -> std::io::Result<()> {
+        for (path, a) in [(to.mass, &self.mass), (to.stiffness, &self.stiffness)] {
+            let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
+            mtx::write_symmetric(&mut out, a, comment)?;
+            std::io::Write::flush(&mut out)?;
+        }
+        let mut dofs = String::from("node,dof\n");
+        for (i, kind) in &self.dofs {
+            dofs += &format!("{},{}\n", self.nodes[*i].id, kind.name());
+        }
+        std::fs::write(to.dofs, dofs)?;
+        let mut nodes = String::from("node,x_m,y_m,z_m\n");
+        for p in &self.nodes {
+            nodes += &format!(
+                "{},{},{},{}\n",
+                p.id, p.position.x, p.position.y, p.position.z
+            );
+        }
+        std::fs::write(to.nodes, nodes)
+    }
+}
+
 fn rename(e: FeError, file: &str) -> FeError {
     match e {
         FeError::File { message, .. } => FeError::file(file, message),
