@@ -179,7 +179,7 @@ fn key(source: &Source, settings: &ReductionSettings, attachments: &[Attachment]
 fn model(source: &Source) -> Result<FeModel, fe::FeError> {
     match source {
         Source::Files(_, [m, k, d, n]) => FeModel::from_files(m, k, d, n),
-        Source::Beam(b) => FeModel::beam(&beam(b)),
+        Source::Beam(b) => FeModel::beam(&Beam::from(*b)),
     }
 }
 
@@ -226,20 +226,22 @@ fn reduce(
     Ok(r)
 }
 
-fn beam(b: &RawBeam) -> Beam {
-    Beam {
-        from_m: b.from_m,
-        to_m: b.to_m,
-        elements: b.elements,
-        y_axis: b.y_axis,
-        area_m2: b.area_m2,
-        iy_m4: b.iy_m4,
-        iz_m4: b.iz_m4,
-        torsion_m4: b.torsion_m4,
-        shear_factor: b.shear_factor,
-        youngs_modulus_pa: b.youngs_modulus_pa,
-        shear_modulus_pa: b.shear_modulus_pa,
-        density_kg_m3: b.density_kg_m3,
+impl From<&RawBeam> for Beam {
+    fn from(b: &RawBeam) -> Beam {
+        Beam {
+            from_m: b.from_m,
+            to_m: b.to_m,
+            elements: b.elements,
+            y_axis: b.y_axis,
+            area_m2: b.area_m2,
+            iy_m4: b.iy_m4,
+            iz_m4: b.iz_m4,
+            torsion_m4: b.torsion_m4,
+            shear_factor: b.shear_factor,
+            youngs_modulus_pa: b.youngs_modulus_pa,
+            shear_modulus_pa: b.shear_modulus_pa,
+            density_kg_m3: b.density_kg_m3,
+        }
     }
 }
 
