@@ -185,7 +185,7 @@ pub enum PredictError {
         test: String,
         /// Why it is no pose.
         #[source]
-        source: PoseError,
+        source: Box<PoseError>,
     },
     /// Simulating a test on one of the machines failed.
     #[error("simulating {test}")]
@@ -196,7 +196,7 @@ pub enum PredictError {
         machine: usize,
         /// What failed.
         #[source]
-        source: SimulationFailure,
+        source: Box<SimulationFailure>,
     },
 }
 
@@ -264,7 +264,7 @@ impl Prediction {
                         source => PredictError::Position {
                             index,
                             test: t.label(),
-                            source,
+                            source: Box::new(source),
                         },
                     })?;
                     poses.push(pose);
@@ -321,7 +321,7 @@ impl Prediction {
                     PredictError::Simulation {
                         test: "closed loop".into(),
                         machine: k / np,
-                        source: e.into(),
+                        source: Box::new(e.into()),
                     }
                 })?;
                 let prepared = match solver {
@@ -344,7 +344,7 @@ impl Prediction {
                     PredictError::Simulation {
                         test: self.tests[t].label(),
                         machine: s,
-                        source,
+                        source: Box::new(source),
                     }
                 })
             })

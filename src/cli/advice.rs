@@ -54,13 +54,14 @@ pub fn identify(e: IdentError) -> anyhow::Error {
         IdentError::AtSimulationLimit { .. } => anyhow::anyhow!(
             "{e}; check the model (a compliance missing elsewhere, the controller gains) or the data; nothing exported"
         ),
-        IdentError::Conditions {
-            source: PredictError::PositionLength { .. },
-            ..
-        } => anyhow::anyhow!(
-            "{} (the circle centre is position_mm from the folder's rtest.toml, --position-mm or the config)",
-            chain(e)
-        ),
+        IdentError::Conditions { ref source, .. }
+            if matches!(**source, PredictError::PositionLength { .. }) =>
+        {
+            anyhow::anyhow!(
+                "{} (the circle centre is position_mm from the folder's rtest.toml, --position-mm or the config)",
+                chain(e)
+            )
+        }
         e => e.into(),
     }
 }

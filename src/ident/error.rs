@@ -2,7 +2,7 @@
 
 use crate::predict::{PredictError, SimulationFailure};
 
-/// Errors of the identification.
+/// Errors of the identification (the errors of the stages below boxed, as they are large).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum IdentError {
     /// A parameter name that does not fit the machine.
@@ -28,11 +28,11 @@ pub enum IdentError {
         input: String,
         /// What is wrong with its conditions.
         #[source]
-        source: PredictError,
+        source: Box<PredictError>,
     },
     /// A prediction error not tied to one measured test.
     #[error(transparent)]
-    Predict(#[from] PredictError),
+    Predict(Box<PredictError>),
     /// Reading or evaluating measured data (the message names file and line).
     #[error(transparent)]
     Rtest(#[from] crate::rtest::RtestError),
@@ -54,7 +54,7 @@ pub enum IdentError {
         params: String,
         /// What failed.
         #[source]
-        source: SimulationFailure,
+        source: Box<SimulationFailure>,
     },
     /// The optimiser ran out of iterations.
     #[error("the optimiser did not converge in {iterations} iterations")]
@@ -93,4 +93,10 @@ pub enum IdentError {
     /// An error of the optimiser itself.
     #[error("optimiser: {0}")]
     Optimiser(String),
+}
+
+impl From<PredictError> for IdentError {
+    fn from(e: PredictError) -> Self {
+        IdentError::Predict(Box::new(e))
+    }
 }

@@ -137,9 +137,9 @@ impl Problem {
             {
                 Some(i) => IdentError::Conditions {
                     input: tests[i].source.clone(),
-                    source: e,
+                    source: Box::new(e),
                 },
-                None => IdentError::Predict(e),
+                None => e.into(),
             })?;
         let rows = tests
             .iter()
@@ -369,7 +369,7 @@ impl Problem {
                     params: self.describe(&thetas[machine]),
                     source,
                 },
-                other => IdentError::Predict(other),
+                other => other.into(),
             })
     }
 
