@@ -74,11 +74,12 @@ fn print_verdict(p: &Problem, result: &IdentResult, report: &IdentReport, second
         let rel = standing
             .rel_std_err()
             .map_or("-".to_string(), |r| format!("{:.1} %", 100.0 * r));
-        let plausible = if standing != Standing::NotIdentifiable && implausible(q.identified) {
-            ", implausible factor"
-        } else {
-            ""
-        };
+        let plausible =
+            if standing != Standing::NotIdentifiable && implausible(&q.name, q.identified) {
+                ", implausible factor"
+            } else {
+                ""
+            };
         match q.std_err {
             Some(s) => outln!(
                 "  {:<22} {:>7.4}   {:>10.4}   {:>8.4}  {:>8}  {}{plausible}",

@@ -153,6 +153,16 @@ pub const PLAUSIBLE_MIN: f64 = 0.1;
 /// A reduction factor above this makes the part stiffer than its catalogue data (a warning).
 pub const PLAUSIBLE_MAX: f64 = 1.0;
 
+/// An elastic body's stiffness factor (`<body>.stiffness`) outside [this,
+/// [`BODY_PLAUSIBLE_MAX`]] is far from its FE model: a factor on Young's modulus of a cast or
+/// welded part is known to some ten per cent, so a factor of 2 says the FE model (sections,
+/// mesh, material) or the joints that hold the body (bolted flanges, feet) are wrong, rather than
+/// the material (a warning).
+pub const BODY_PLAUSIBLE_MIN: f64 = 0.5;
+
+/// See [`BODY_PLAUSIBLE_MIN`].
+pub const BODY_PLAUSIBLE_MAX: f64 = 2.0;
+
 /// Singular values of the weighted Jacobian below this fraction of the largest mark a
 /// parameter combination the tests hardly separate (a warning).
 pub const NEAR_SINGULAR: f64 = 1e-8;

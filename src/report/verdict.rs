@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use super::page::escape;
 use super::short;
 use crate::ident::report::IdentReport;
-use crate::ident::verdict::{implausible, Standing};
+use crate::ident::verdict::{Implausible, Standing};
 
 /// An identify report read for the page, with its letter (`A`, `B`, …) for the comparison.
 #[derive(Debug, Clone)]
@@ -192,12 +192,10 @@ pub fn parameters_html(r: &IdentReport) -> String {
                 remark.push(format!("bounds [{}, {}]", short(lo, 4), short(hi, 4)));
             }
         }
-        if s != Standing::NotIdentifiable && implausible(p.identified) {
-            remark.push(if p.identified > 1.0 {
-                "implausible: stiffer than the catalogue".into()
-            } else {
-                "implausible: more than ten times softer than the catalogue".into()
-            });
+        if let Some(why) = Implausible::of(&p.name, p.identified) {
+            if s != Standing::NotIdentifiable {
+                remark.push(format!("implausible: {}", why.remark()));
+            }
         }
         let _ = writeln!(
             h,
