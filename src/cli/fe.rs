@@ -197,6 +197,12 @@ fn text(machine: &Machine, raw: &RawBody, s: &FeSummary) -> String {
     }
     t += &format!("{}\n", resolution(s, &d, cutoff_hz(raw)));
     t += "Attachments at the reference position (FE node: weight):\n";
+    let width = s
+        .attachments
+        .iter()
+        .map(|a| a.point.chars().count())
+        .max()
+        .unwrap_or(0);
     for a in &s.attachments {
         let nodes: Vec<String> = a
             .nodes
@@ -204,7 +210,7 @@ fn text(machine: &Machine, raw: &RawBody, s: &FeSummary) -> String {
             .zip(&a.weights)
             .map(|(n, w)| format!("{n}: {w:.3}"))
             .collect();
-        t += &format!("  {:<22} {}\n", a.point, nodes.join(", "));
+        t += &format!("  {:<width$}  {}\n", a.point, nodes.join(", "));
     }
     t
 }
