@@ -92,6 +92,16 @@ fn rows(d: &CircleDiagnosis) -> Vec<(String, Figure, f64)> {
     rows
 }
 
+/// `value ± std_err` with the standard error to two significant digits (1 to 6 decimals).
+pub fn value_se(value: f64, std_err: f64) -> String {
+    let d = if std_err.is_finite() && std_err > 0.0 {
+        (1.0 - std_err.log10().floor()).clamp(1.0, 6.0) as usize
+    } else {
+        3
+    };
+    format!("{value:.d$} ± {std_err:.d$}")
+}
+
 /// One cell: value ± standard error, its share of G (or of the out-of-plane range) and the
 /// values at the reversal points, coloured by its verdict; grey where within its noise.
 fn cell(t: Option<&Term>) -> String {
@@ -110,10 +120,9 @@ fn cell(t: Option<&Term>) -> String {
         Figure::OutOfPlane => "p–v",
     };
     let mut h = format!(
-        "<td class=\"{}\">{:.3} ± {:.3}<br><small>{share} {:.2}",
+        "<td class=\"{}\">{}<br><small>{share} {:.2}",
         class.trim(),
-        t.value,
-        t.std_err,
+        value_se(t.value, t.std_err),
         t.contribution_um
     );
     if let Some(l) = t.limit {
