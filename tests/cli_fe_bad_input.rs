@@ -33,22 +33,8 @@ fn refused(tag: &str, file: &str, text: String, edit: (&str, &str), needles: &[&
     assert!(machine.contains(edit.0), "{}", edit.0);
     let m = s.write("m.toml", machine.replacen(edit.0, edit.1, 1));
     let out = s.s("circle.csv");
-    let run = common::eij(&[
-        "simulate",
-        "circle",
-        "--machine",
-        &m,
-        "--plane",
-        "zx",
-        "--radius-mm",
-        "2",
-        "--accel-m-s2",
-        "5",
-        "--direction",
-        "ccw",
-        "--out",
-        &out,
-    ]);
+    let args = common::circle_args(&m, &out);
+    let run = common::eij(&args.iter().map(String::as_str).collect::<Vec<_>>());
     let line = one_line_error(&run, needles);
     assert!(line.contains("m.toml: body[column]"), "{line}");
     assert!(!s.path("circle.csv").exists(), "{line}");
