@@ -3,7 +3,7 @@
 
 pub use super::settings::MeasuredOptions;
 use super::{IdentError, TestCase};
-use crate::measured::conditions::Recording;
+use crate::measured::conditions::DataFiles;
 use crate::measured::inputs::{MeasuredInputs, TestInput};
 use crate::measured::suite::{evaluate_tests, ClockReport, SuiteOptions};
 use crate::measured::table;
@@ -43,7 +43,7 @@ pub fn load_measured(
     let inputs = &inputs.tests;
     let (tables, series): (Vec<&TestInput>, Vec<&TestInput>) = inputs
         .iter()
-        .partition(|t| matches!(&t.recording, Recording::Single(f) if table::looks_like_table(f)));
+        .partition(|t| matches!(&t.data, DataFiles::Single(f) if table::looks_like_table(f)));
     let series: Vec<TestInput> = series.into_iter().cloned().collect();
     let suite = evaluate_tests(
         &series,

@@ -5,7 +5,7 @@
 use super::{group_key, series_at, Data, Prepared, SuiteOptions};
 use crate::measured::inputs::TestInput;
 use crate::measured::MeasuredError;
-use crate::rtest::clock::{self, Recording as Record};
+use crate::rtest::clock::{self, Recording};
 use crate::rtest::clock_fit::{fit_offset, OffsetFit, OffsetTest};
 use crate::rtest::error::{Location, RtestError};
 use crate::rtest::normalise::{normalise, Normalised};
@@ -94,7 +94,11 @@ const SAME_CLOCK_SPREAD_S: f64 = 2e-3;
 const UNIQUE_ALIGNMENT_RATIO: f64 = 3.0;
 
 /// The internal recording alone, as a series, to find its circle and period.
-fn internal_period(input: &TestInput, r: &Record, opts: &EvalOptions) -> Result<f64, RtestError> {
+fn internal_period(
+    input: &TestInput,
+    r: &Recording,
+    opts: &EvalOptions,
+) -> Result<f64, RtestError> {
     let s = CircleSeries::new(r.source.clone(), r.t_s.clone(), r.mm.clone(), r.mm.clone())?;
     let norm = normalise(&s, opts).map_err(|e| match e {
         RtestError::TooShort { detail, .. } => RtestError::TooShort {

@@ -4,12 +4,12 @@
 //! test evaluated at its set radius, and cw/ccw pairs given their ISO 230-4 bi-directional
 //! circular deviation.
 
-use super::conditions::Recording;
+use super::conditions::DataFiles;
 use super::error::MeasuredError;
 use super::inputs::TestInput;
 use super::json::{CircleJson, TestJson, TimeOffsetJson};
 use crate::axes::{Direction, Eij, Plane};
-use crate::rtest::clock::{self, Recording as Record};
+use crate::rtest::clock::{self, Recording};
 use crate::rtest::normalise::Normalised;
 use crate::rtest::{evaluate, iso230, CircleResult, CircleSeries, EvalOptions};
 use rayon::prelude::*;
@@ -113,7 +113,10 @@ pub(super) struct Prepared {
 
 pub(super) enum Data {
     Single(CircleSeries),
-    Split { internal: Record, external: Record },
+    Split {
+        internal: Recording,
+        external: Recording,
+    },
 }
 
 fn eval_options(input: &TestInput, opts: &SuiteOptions) -> (EvalOptions, RadiusSource) {
@@ -145,9 +148,9 @@ pub fn evaluate_tests(inputs: &[TestInput], opts: &SuiteOptions) -> Result<Suite
         .par_iter()
         .map(|input| -> Result<Prepared, MeasuredError> {
             let (eval, source) = eval_options(input, opts);
-            let data = match &input.recording {
-                Recording::Single(_) => Data::Single(input.read_single()?),
-                Recording::Split { internal, external } => Data::Split {
+            let data = match &input.data {
+                DataFiles::Single(_) => Data::Single(input.read_single()?),
+                DataFiles::Split { internal, external } => Data::Split {
                     internal: super::recording::read_internal(internal, &input.internal_columns)?,
                     external: super::recording::read_external(external, &input.external_columns)?,
                 },
@@ -264,13 +267,13 @@ pub(super) fn series_at(
 }
 
 /// A single-file series as its two recordings on the same clock.
-fn split_series(s: &CircleSeries) -> Result<(Record, Record), MeasuredError> {
+fn split_series(s: &CircleSeries) -> Result<(Recording, Recording), MeasuredError> {
     use crate::axes::Axis;
     let int = Axis::ALL.map(|a| s.int_mm(a).to_vec());
     let ext = Axis::ALL.map(|a| s.ext_mm(a).to_vec());
     Ok((
-        Record::new(s.source().to_string(), s.t_s().to_vec(), int)?,
-        Record::new(s.source().to_string(), s.t_s().to_vec(), ext)?,
+        Recording::new(s.source().to_string(), s.t_s().to_vec(), int)?,
+        Recording::new(s.source().to_string(), s.t_s().to_vec(), ext)?,
     ))
 }
 
