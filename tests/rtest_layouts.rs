@@ -83,7 +83,7 @@ fn evaluate_folder(dir: &std::path::Path, opts: &SuiteOptions) -> Suite {
 }
 
 fn eij_of(suite: &Suite, i: usize) -> BTreeMap<Eij, f64> {
-    suite.tests[i].result.eij.clone()
+    suite.tests[i].result.eij.value_map()
 }
 
 /// Largest |difference| between two parameter sets.
@@ -283,9 +283,9 @@ fn two_system_recordings_give_the_single_file_eij_and_the_clock_offset() {
             name.contains(&format!("cnc_{stem}.csv")),
             "{name} vs {stem}"
         );
-        let (e_split, e_single) = (&t.result.eij, &s.result.eij);
+        let (e_split, e_single) = (t.result.eij.value_map(), s.result.eij.value_map());
         let largest = e_single.values().fold(0.0f64, |m, v| m.max(v.abs()));
-        for (p, v) in e_single {
+        for (p, v) in &e_single {
             let tol = if p.deviation == p.accelerated {
                 0.02 * v.abs()
             } else {
@@ -449,7 +449,7 @@ fn a_lagging_logger_is_found_and_corrected() {
             .iter()
             .find(|t| t.input.name().ends_with(name))
             .unwrap();
-        t.result.eij[&exz]
+        t.result.eij[&exz].value
     };
     assert!((at("/cw_2.csv") - at("/ccw_2.csv")).abs() > 10.0);
 
@@ -483,9 +483,9 @@ fn assert_corrected(t: &EvaluatedTest, clean: &EvaluatedTest, source: OffsetSour
     let largest = clean
         .result
         .eij
-        .values()
-        .fold(0.0f64, |m, v| m.max(v.abs()));
-    let diff = max_diff(&t.result.eij, &clean.result.eij);
+        .iter()
+        .fold(0.0f64, |m, (_, e)| m.max(e.value.abs()));
+    let diff = max_diff(&t.result.eij.value_map(), &clean.result.eij.value_map());
     assert!(
         diff < 0.02 * largest,
         "{}: {diff} of {largest}",
@@ -542,8 +542,8 @@ fn ellipses_jitter_and_gaps_are_evaluated() {
     let largest = round
         .result
         .eij
-        .values()
-        .fold(0.0f64, |m, v| m.max(v.abs()));
+        .iter()
+        .fold(0.0f64, |m, (_, e)| m.max(e.value.abs()));
     for (stem, tol) in [("ellipse", 0.06), ("jitter", 0.02), ("gaps", 0.02)] {
         let t = by(stem);
         assert!(
@@ -551,16 +551,16 @@ fn ellipses_jitter_and_gaps_are_evaluated() {
             "{stem}: {} revolutions",
             t.result.revolutions
         );
-        for (p, v) in &round.result.eij {
+        for (p, v) in &round.result.eij.value_map() {
             let bound = if p.deviation == p.accelerated {
                 tol * v.abs()
             } else {
                 tol * largest
             };
             assert!(
-                (t.result.eij[p] - v).abs() < bound,
+                (t.result.eij[p].value - v).abs() < bound,
                 "{stem} {p}: {} vs round {v}",
-                t.result.eij[p]
+                t.result.eij[p].value
             );
         }
     }

@@ -3,6 +3,7 @@
 
 pub use super::settings::MeasuredOptions;
 use super::{IdentError, TestCase};
+use crate::axes::EijEstimates;
 use crate::measured::conditions::DataFiles;
 use crate::measured::inputs::{MeasuredInputs, TestInput};
 use crate::measured::suite::{evaluate_tests, ClockReport, SuiteOptions};
@@ -100,11 +101,7 @@ pub fn load_measured(
                 accel_m_s2: result.accel_m_s2,
                 position_m,
             },
-            measured: result
-                .eij
-                .iter()
-                .map(|(p, v)| (*p, (*v, result.std_err[p])))
-                .collect(),
+            measured: result.eij,
             clock: Some(
                 input
                     .primary_file()
@@ -143,7 +140,7 @@ fn table_of_series(tests: &[TestCase]) -> Option<(String, String)> {
                 && !t.measured.is_empty()
                 && t.measured
                     .iter()
-                    .all(|(p, (v, _))| s.measured.get(p).is_some_and(|(w, _)| same(*v, *w)))
+                    .all(|(p, v)| s.measured.value(p).is_some_and(|w| same(v.value, w)))
         });
         if let Some(s) = repeated {
             return Some((
@@ -186,13 +183,11 @@ fn table_tests(
                 accel_m_s2: row.accel_m_s2,
                 position_m: position_m.clone(),
             },
-            measured: BTreeMap::new(),
+            measured: EijEstimates::new(),
             clock: None,
         });
-        case.measured.insert(
-            row.parameter,
-            (row.value, row.std_err.unwrap_or(opts.table_std_err)),
-        );
+        let std_err = row.std_err.unwrap_or(opts.table_std_err);
+        case.measured.insert(row.parameter, row.value, std_err);
     }
     Ok(groups.into_values().collect())
 }

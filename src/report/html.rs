@@ -407,8 +407,7 @@ fn move_vs_circle_html(
         for (e, v) in &m.eij {
             let vals: Vec<f64> = circles
                 .iter()
-                .filter_map(|c| c.result.eij.get(e))
-                .copied()
+                .filter_map(|c| c.result.eij.value(e))
                 .collect();
             let circle = if vals.is_empty() {
                 "–".to_string()
@@ -424,8 +423,8 @@ fn move_vs_circle_html(
                 "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
                 escape(&path.display().to_string()),
                 e.name(),
-                fmt_eij(*v),
-                fmt_eij(m.std_err[e]),
+                fmt_eij(v.value),
+                fmt_eij(v.std_err),
                 circle
             );
         }
@@ -470,8 +469,8 @@ fn circle_tables(h: &mut String, circles: &[EvaluatedTest]) {
                 let _ = write!(
                     h,
                     "<td>{} ± {}</td>",
-                    fmt_eij(r.eij[&p]),
-                    fmt_eij(r.std_err[&p])
+                    fmt_eij(r.eij[&p].value),
+                    fmt_eij(r.eij[&p].std_err)
                 );
             }
             let _ = writeln!(h, "<td>{:.3}</td></tr>", r.rms_residual_um);
