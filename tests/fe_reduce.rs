@@ -122,7 +122,7 @@ fn reduced_free_free_frequencies_match_the_full_model_below_half_the_cutoff() {
     for (s, f) in sparse.iter().zip(elastic) {
         assert!((s - f).abs() <= 1e-8 * f, "{s} vs {f}");
     }
-    let summary = body.summary("column", &[0.0, 0.0, 0.3]);
+    let summary = body.summary("column", &[0.0, 0.0, 0.3], 1.0);
     assert_eq!(summary.interface_dofs, body.interface_dofs());
     assert_eq!(
         summary.free_frequencies_hz.len(),

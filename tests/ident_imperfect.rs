@@ -324,12 +324,14 @@ fn held_out_tests_are_predicted_within_their_uncertainty() {
     )
     .unwrap();
     let result = identify(&problem, None).unwrap();
-    let v = eij::ident::validation::validate(&result.machine, load(&hold), &settings).unwrap();
+    let cov = eij::ident::validation::ParameterCovariance::of(problem.parameters(), &result);
+    let v = eij::ident::validation::validate(&result.machine, Some(&cov), load(&hold), &settings)
+        .unwrap();
     assert!(v.passed, "χ²/dof = {}", v.chi2_per_dof);
     assert_eq!(v.tests.len(), 12);
     assert!(v.tests.iter().all(|t| t.rms_z < 3.0));
     // The catalogue model does not predict them: the validation can fail.
-    let v0 = eij::ident::validation::validate(&base, load(&hold), &settings).unwrap();
+    let v0 = eij::ident::validation::validate(&base, None, load(&hold), &settings).unwrap();
     assert!(
         !v0.passed && v0.chi2_per_dof > 100.0,
         "χ²/dof = {}",

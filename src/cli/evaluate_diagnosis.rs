@@ -4,13 +4,7 @@
 use std::fmt::Write as _;
 
 use eij::measured::suite::diagnose::SuiteDiagnosis;
-use eij::rtest::diagnosis::{Figure, Source, SourceDiagnosis, Term};
-
-/// A term is shown when it stands out of its noise by this many standard errors (or has a
-/// limit).
-const SHOWN_BEYOND_SE: f64 = 3.0;
-/// …and changes G (or the out-of-plane range) by at least this, µm.
-const SHOWN_FROM_UM: f64 = 0.01;
+use eij::rtest::diagnosis::{Figure, Source, SourceDiagnosis, STANDS_OUT_SE, STANDS_OUT_UM};
 
 /// Raised when a judged test fails its tolerances: `main` exits with [`EXIT_CODE`] after the
 /// output is written.
@@ -47,11 +41,6 @@ fn what(source: Source) -> &'static str {
         Source::Structure => "external − internal, the structure",
         Source::Tcp => "the TCP, as a ballbar sees it",
     }
-}
-
-fn shown(t: &Term) -> bool {
-    t.limit.is_some()
-        || (t.value.abs() > SHOWN_BEYOND_SE * t.std_err && t.contribution_um >= SHOWN_FROM_UM)
 }
 
 /// The diagnosis of test `i`.
@@ -108,7 +97,7 @@ fn render_source(out: &mut String, s: &SourceDiagnosis) {
     let _ = writeln!(out, "    {} — {}", s.source.name(), what(s.source));
     let mut hidden = 0;
     for (rank, t) in s.terms.iter().enumerate() {
-        if !shown(t) {
+        if !t.stands_out() {
             hidden += 1;
             continue;
         }
@@ -146,8 +135,8 @@ fn render_source(out: &mut String, s: &SourceDiagnosis) {
     if hidden > 0 {
         let _ = writeln!(
             out,
-            "         ({hidden} more within {SHOWN_BEYOND_SE} standard errors of 0 or below \
-             {SHOWN_FROM_UM} µm)"
+            "         ({hidden} more within {STANDS_OUT_SE} standard errors of 0 or below \
+             {STANDS_OUT_UM} µm)"
         );
     }
     for n in &s.notes {

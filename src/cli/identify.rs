@@ -5,7 +5,7 @@ use anyhow::{bail, Context};
 use eij::ident::config::{IdentConfig, KnownGood};
 use eij::ident::measured::{self, MeasuredOptions};
 use eij::ident::report::{self, Provenance};
-use eij::ident::validation::{self, Validation};
+use eij::ident::validation::{self, ParameterCovariance, Validation};
 use eij::ident::{
     identify, IdentResult, Method, Parameter, Problem, Settings, SolverKind, StaticTerms,
 };
@@ -437,11 +437,17 @@ fn check_validation(
     result: &IdentResult,
     tests: Vec<eij::ident::TestCase>,
 ) -> anyhow::Result<Validation> {
-    let v = validation::validate(&result.machine, tests, prep.problem.settings())
-        .map_err(super::advice::identify)?;
+    let covariance = ParameterCovariance::of(prep.problem.parameters(), result);
+    let v = validation::validate(
+        &result.machine,
+        Some(&covariance),
+        tests,
+        prep.problem.settings(),
+    )
+    .map_err(super::advice::identify)?;
     if !v.passed {
         errln!(
-            "warning: hold-out validation failed: the identified model does not predict the {} held-out value(s) within their measurement uncertainty (χ²/dof = {:.2} over {} degrees of freedom)",
+            "warning: hold-out validation failed: the identified model does not predict the {} held-out value(s) within their uncertainty, measurement and identified parameters (χ²/dof = {:.2} over {} degrees of freedom)",
             v.values, v.chi2_per_dof, v.dof
         );
     }

@@ -428,30 +428,33 @@ fn print_design(d: &Design, tables: bool) {
 /// The hold-out validation: the verdict, with `tables` one line per test.
 pub(super) fn print_validation(v: &Validation, tables: bool) {
     outln!(
-        "\n  hold-out validation: {} values, χ²/dof = {:.2} ({})",
+        "\n  hold-out validation: {} values, χ²/dof = {:.2} over {} degrees of freedom ({}; {:.2} counting the measurement uncertainty alone)",
         v.values,
         v.chi2_per_dof,
+        v.dof,
         if v.passed {
-            "predicted within the measurement uncertainty"
+            "predicted within the uncertainty of measurement and identified parameters"
         } else {
-            "NOT predicted within the measurement uncertainty"
-        }
+            "NOT predicted within the uncertainty of measurement and identified parameters"
+        },
+        v.chi2_per_dof_measurement_only
     );
     if !tables {
         return;
     }
     outln!(
-        "  {:<40} rms z   max |z|   rms error   rms σ  (µm·s²/m; z = (predicted − measured)/σ)",
+        "  {:<40} rms z   max |z|   rms error   rms σ   rms σ_pred  (µm·s²/m; z = (predicted − measured)/√(σ² + σ_pred²))",
         "test"
     );
     for t in &v.tests {
         outln!(
-            "  {:<40} {:>5.2}   {:>7.2}   {:>9.4}   {:>6.4}",
+            "  {:<40} {:>5.2}   {:>7.2}   {:>9.4}   {:>6.4}   {:>10.4}",
             t.label,
             t.rms_z,
             t.max_abs_z,
             t.rms_error_um_s2_per_m,
-            t.rms_sigma_um_s2_per_m
+            t.rms_sigma_um_s2_per_m,
+            t.rms_prediction_sigma_um_s2_per_m
         );
     }
 }

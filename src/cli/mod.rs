@@ -33,6 +33,7 @@ pub mod evaluate;
 pub mod evaluate_diagnosis;
 mod evaluate_move;
 mod export;
+mod fe;
 mod identify;
 mod identify_print;
 mod machine_args;
@@ -67,6 +68,9 @@ enum Command {
     Modal(modal::ModalArgs),
     /// Export the assembled model (M, D, K) and the closed loop (A, B, C, D) as JSON.
     Export(export::ExportArgs),
+    /// An elastic body's FE model and its reduction: mass properties, reduced vs full free-free
+    /// frequencies, attachments.
+    Fe(fe::FeArgs),
     /// Identify stiffness reduction factors from measured EIJ (defaults: the bundled demo).
     Identify(identify::IdentifyArgs),
     /// Re-run stored known-good identifications and fail if a result drifts.
@@ -93,6 +97,7 @@ impl Cli {
             Command::Simulate(args) => simulate::run(args),
             Command::Modal(args) => modal::run(args),
             Command::Export(args) => export::run(args),
+            Command::Fe(args) => fe::run(args),
             Command::Identify(args) => identify::run(args),
             Command::Verify(args) => identify::verify(args),
             Command::Map(args) => map::run(args),

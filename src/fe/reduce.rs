@@ -126,6 +126,11 @@ pub struct FeSummary {
     pub free_frequencies_hz: Vec<f64>,
     /// The same of the full FE model (empty where not computed).
     pub full_free_frequencies_hz: Vec<f64>,
+    /// The factor on the body's elastic stiffness both frequency lists hold at.
+    pub stiffness_factor: f64,
+    /// Interface coordinates kept: `interface_dofs`, or 6 + `interface_modes` where the interface
+    /// was reduced.
+    pub interface_coordinates: usize,
     /// Wall time of the reduction, s.
     pub reduction_s: f64,
     /// Every attachment at the reference position.
@@ -283,21 +288,11 @@ pub fn reduce(
         .collect();
     let reduction_s = start.elapsed().as_secs_f64();
 
-    let full = if settings.full_reference && !basis.eigenvalues.is_empty() {
-        let shift_hz = 0.1 * basis.eigenvalues[0].sqrt() / std::f64::consts::TAU;
-        Some(free_free_frequencies_hz(
-            model,
-            basis.eigenvalues.len(),
-            shift_hz,
-        )?)
-    } else {
-        None
-    };
-    Ok(ReducedBody {
+    let mut body = ReducedBody {
         mass,
         eigenvalues: basis.eigenvalues,
         fixed_interface_eigenvalues: phi.eigenvalues,
-        full_free_frequencies_hz: full,
+        full_free_frequencies_hz: None,
         dofs: n,
         reduction_s,
         factor_nnz,
@@ -306,7 +301,11 @@ pub fn reduce(
         resolved,
         station_motion,
         node_ids: model.nodes.iter().map(|p| p.id).collect(),
-    })
+    };
+    if settings.full_reference {
+        body.add_full_reference(model)?;
+    }
+    Ok(body)
 }
 
 fn diagonal(a: &super::SparseMatrix, i: usize) -> f64 {
@@ -545,10 +544,42 @@ impl ReducedBody {
         }
     }
 
+    /// Computes the full model's elastic free-free frequencies (as many as the reduced body
+    /// has, [`free_free_frequencies_hz`]) for comparison, where not yet done: `model` must be the
+    /// one this body was reduced from. The shift lies at a tenth of the first reduced frequency,
+    /// below the full model's first (Craig–Bampton's frequencies are upper bounds).
+    pub fn add_full_reference(&mut self, model: &FeModel) -> Result<(), FeError> {
+        if self.full_free_frequencies_hz.is_some() {
+            return Ok(());
+        }
+        if model.n_dofs() != self.dofs {
+            return Err(fail(
+                model,
+                format!(
+                    "the model has {} DOFs, the reduced body was made from {}",
+                    model.n_dofs(),
+                    self.dofs
+                ),
+            ));
+        }
+        let full = match self.eigenvalues.first() {
+            None => Vec::new(),
+            Some(first) => free_free_frequencies_hz(
+                model,
+                self.eigenvalues.len(),
+                0.1 * first.sqrt() / std::f64::consts::TAU,
+            )?,
+        };
+        self.full_free_frequencies_hz = Some(full);
+        Ok(())
+    }
+
     /// The `eij fe` summary, attachments at the positions `s` (one per attachment; travelling
-    /// ones at their reference position).
-    pub fn summary(&self, body: &str, positions: &[f64]) -> FeSummary {
+    /// ones at their reference position), frequencies (reduced and full alike) at the stiffness
+    /// factor `c`: ω² scales by c, so f by √c.
+    pub fn summary(&self, body: &str, positions: &[f64], stiffness_factor: f64) -> FeSummary {
         let j = self.mass.inertia_kg_m2;
+        let root = stiffness_factor.max(0.0).sqrt();
         FeSummary {
             body: body.to_string(),
             dofs: self.dofs,
@@ -557,8 +588,15 @@ impl ReducedBody {
             mass_kg: self.mass.mass_kg,
             cog_m: self.mass.cog_m.into(),
             inertia_kg_m2: std::array::from_fn(|r| std::array::from_fn(|c| j[(r, c)])),
-            free_frequencies_hz: self.frequencies_hz(1.0),
-            full_free_frequencies_hz: self.full_free_frequencies_hz.clone().unwrap_or_default(),
+            free_frequencies_hz: self.frequencies_hz(stiffness_factor),
+            full_free_frequencies_hz: self
+                .full_free_frequencies_hz
+                .iter()
+                .flatten()
+                .map(|f| f * root)
+                .collect(),
+            stiffness_factor,
+            interface_coordinates: self.interface_coordinates(),
             reduction_s: self.reduction_s,
             attachments: (0..self.attachments.len())
                 .map(|i| self.attachment_nodes(i, positions.get(i).copied().unwrap_or(0.0)))

@@ -200,7 +200,7 @@ pub struct ValidatedTestReport {
     pub source: String,
     /// Conditions.
     pub label: String,
-    /// RMS of z = (E_sim − E_meas)/σ.
+    /// RMS of z = (E_sim − E_meas)/√(σ² + σ_pred²), σ_pred from the parameters' covariance.
     pub rms_z: f64,
     /// Largest |z|.
     pub max_abs_z: f64,
@@ -208,6 +208,10 @@ pub struct ValidatedTestReport {
     pub rms_error_um_s2_per_m: f64,
     /// RMS measurement uncertainty, µm·s²/m.
     pub rms_sigma_um_s2_per_m: f64,
+    /// RMS standard deviation of the prediction from the identified parameters' covariance,
+    /// µm·s²/m (absent in reports written before it was computed).
+    #[serde(default)]
+    pub rms_prediction_sigma_um_s2_per_m: Option<f64>,
 }
 
 /// The hold-out validation.
@@ -217,8 +221,12 @@ pub struct ValidationReport {
     pub values: usize,
     /// Degrees of freedom.
     pub dof: usize,
-    /// Σz²/dof.
+    /// χ²/dof with the measurement uncertainty and the parameters' covariance
+    /// ([`super::validation`]).
     pub chi2_per_dof: f64,
+    /// χ²/dof with the measurement uncertainty alone (absent in older reports).
+    #[serde(default)]
+    pub chi2_per_dof_measurement_only: Option<f64>,
     /// Whether predicted within the measurement uncertainty.
     pub passed: bool,
     /// Per test.
@@ -231,6 +239,7 @@ impl From<&Validation> for ValidationReport {
             values: v.values,
             dof: v.dof,
             chi2_per_dof: v.chi2_per_dof,
+            chi2_per_dof_measurement_only: Some(v.chi2_per_dof_measurement_only),
             passed: v.passed,
             tests: v
                 .tests
@@ -242,6 +251,7 @@ impl From<&Validation> for ValidationReport {
                     max_abs_z: t.max_abs_z,
                     rms_error_um_s2_per_m: t.rms_error_um_s2_per_m,
                     rms_sigma_um_s2_per_m: t.rms_sigma_um_s2_per_m,
+                    rms_prediction_sigma_um_s2_per_m: Some(t.rms_prediction_sigma_um_s2_per_m),
                 })
                 .collect(),
         }

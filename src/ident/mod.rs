@@ -120,6 +120,10 @@ pub struct IdentResult {
     pub not_identifiable: Vec<NotIdentifiable>,
     /// Correlation matrix of the identifiable parameters (order of `parameters`, others 0).
     pub correlation: DMatrix<f64>,
+    /// Covariance of θ = 1/p, s²·(JᵀJ)⁻¹ (order of `parameters`; rows and columns of the
+    /// parameters kept at their start value 0): what a prediction with the identified
+    /// machine inherits ([`validation`]).
+    pub covariance_theta: DMatrix<f64>,
     /// Singular values of the weighted Jacobian ∂r/∂θ (θ = 1/p) at the solution, descending.
     pub singular_values: Vec<f64>,
     /// Σr² at the start.
@@ -278,6 +282,7 @@ pub fn identify(
         parameters,
         not_identifiable: analysis.not_identifiable,
         correlation: fit.correlation,
+        covariance_theta: fit.covariance_theta,
         singular_values: fit.uncertainty.singular_values,
         cost_initial: r0.norm_squared(),
         cost_final: fit.cost,
@@ -309,6 +314,8 @@ struct FitUncertainty {
     uncertainty: Uncertainty,
     /// Correlation matrix over all parameters (held ones 0).
     correlation: DMatrix<f64>,
+    /// Covariance of θ over all parameters (held ones 0).
+    covariance_theta: DMatrix<f64>,
     /// The static terms' estimates.
     static_estimates: Vec<StaticEstimate>,
 }
@@ -348,15 +355,18 @@ impl FitUncertainty {
             .collect();
         let n = theta.len();
         let mut correlation = DMatrix::zeros(n, n);
+        let mut covariance_theta = DMatrix::zeros(n, n);
         for (a, &i) in free.iter().enumerate() {
             for (b, &k) in free.iter().enumerate() {
                 correlation[(i, k)] = u.correlation[(a, b)];
+                covariance_theta[(i, k)] = u.covariance[(a, b)];
             }
         }
         Ok(FitUncertainty {
             cost,
             uncertainty: u,
             correlation,
+            covariance_theta,
             static_estimates,
         })
     }

@@ -175,6 +175,36 @@ fn key(source: &Source, settings: &ReductionSettings, attachments: &[Attachment]
     format!("{origin}|{settings:?}|{attachments:?}")
 }
 
+/// The body's FE model, read from its files or built as a beam.
+fn model(source: &Source) -> Result<FeModel, fe::FeError> {
+    match source {
+        Source::Files(_, [m, k, d, n]) => FeModel::from_files(m, k, d, n),
+        Source::Beam(b) => FeModel::beam(&beam(b)),
+    }
+}
+
+/// Where a body's FE model comes from (`[body.fe]` paths relative to `base`, the machine file's
+/// folder); `None` for a body without one.
+fn source<'a>(rb: &'a RawBody, base: &Path) -> Result<Option<Source<'a>>, &'static str> {
+    match (&rb.fe, &rb.beam) {
+        (Some(f), None) => {
+            let path = |rel: &str| base.join(rel);
+            Ok(Some(Source::Files(
+                f,
+                [
+                    path(&f.mass_matrix),
+                    path(&f.stiffness_matrix),
+                    path(&f.dofs),
+                    path(&f.nodes),
+                ],
+            )))
+        }
+        (None, Some(beam)) => Ok(Some(Source::Beam(beam))),
+        (None, None) => Ok(None),
+        (Some(_), Some(_)) => Err("give either [body.fe] or [body.beam], not both"),
+    }
+}
+
 fn reduce(
     source: &Source,
     settings: &ReductionSettings,
@@ -184,10 +214,7 @@ fn reduce(
     if let Some(r) = cache().lock().ok().and_then(|c| c.get(&key).cloned()) {
         return Ok(r);
     }
-    let model = match source {
-        Source::Files(_, [m, k, d, n]) => FeModel::from_files(m, k, d, n)?,
-        Source::Beam(b) => FeModel::beam(&beam(b))?,
-    };
+    let model = model(source)?;
     let reduced = fe::reduce(&model, attachments, settings)?;
     let r = Arc::new(Reduction {
         reduced,
@@ -224,6 +251,47 @@ impl Machine {
             Site::Joint(j) => format!("joint[{}]", self.joints[j].name),
             other => other.to_string(),
         }
+    }
+
+    /// `eij fe`'s summary of body `b` (CONTRACT "Flexible bodies"): its FE model, its reduction
+    /// for this machine's attachments (at the reference position) and, for comparison, the full
+    /// model's elastic free-free frequencies (the model read or built again, a sparse
+    /// eigensolution of the whole model). Frequencies hold at the body's stiffness factor.
+    /// `None` where body `b` has no `[body.fe]` or `[body.beam]` (a rigid or fixed body).
+    pub fn fe_summary(&self, b: usize) -> Result<Option<fe::FeSummary>, MachineError> {
+        let Some(body) = self.bodies.get(b) else {
+            return Ok(None);
+        };
+        let Some(elastic) = body.elastic() else {
+            return Ok(None);
+        };
+        let Some(fe_body) = elastic.model().as_any().downcast_ref::<FeBody>() else {
+            return Ok(None);
+        };
+        let rb = &self.raw.bodies[b];
+        // The machine's construction made the [body.fe] paths absolute.
+        let Ok(Some(source)) = source(rb, Path::new("")) else {
+            return Ok(None);
+        };
+        let key = match source {
+            Source::Files(..) => "fe",
+            Source::Beam(_) => "beam",
+        };
+        let err = |e: fe::FeError| {
+            MachineError::new(
+                &self.source,
+                format!("body[{}].{key}", rb.name),
+                e.to_string(),
+            )
+        };
+        let model = model(&source).map_err(err)?;
+        let mut reduced = fe_body.reduction.reduced.clone();
+        reduced.add_full_reference(&model).map_err(err)?;
+        Ok(Some(reduced.summary(
+            &body.name,
+            &fe_body.reference_positions(),
+            elastic.stiffness_factor(),
+        )))
     }
 
     /// The attachments of body `b` for its reduction, and how each site reaches them.
@@ -293,26 +361,14 @@ impl Machine {
             .unwrap_or(Path::new(""))
             .to_path_buf();
         for (b, rb) in raw_bodies.iter().enumerate() {
-            let source = match (&rb.fe, &rb.beam) {
-                (Some(f), None) => {
-                    let path = |rel: &str| base.join(rel);
-                    Source::Files(
-                        f,
-                        [
-                            path(&f.mass_matrix),
-                            path(&f.stiffness_matrix),
-                            path(&f.dofs),
-                            path(&f.nodes),
-                        ],
-                    )
-                }
-                (None, Some(beam)) => Source::Beam(beam),
-                (None, None) => continue,
-                (Some(_), Some(_)) => {
+            let source = match source(rb, &base) {
+                Ok(Some(source)) => source,
+                Ok(None) => continue,
+                Err(m) => {
                     return Err(MachineError::new(
                         &self.source,
                         format!("body[{}]", rb.name),
-                        "give either [body.fe] or [body.beam], not both",
+                        m,
                     ))
                 }
             };

@@ -40,6 +40,8 @@ pub struct TestConditions {
     pub tolerances: Tolerances,
     /// Settings of the diagnosis (`[diagnosis]`).
     pub diagnosis: DiagnosisSettings,
+    /// Machine, date, instrument and temperature of the measurement (top-level keys).
+    pub session: Session,
     /// The `rtest.toml` these conditions come from, if any.
     pub file: Option<PathBuf>,
 }
@@ -102,6 +104,49 @@ impl DiagnosisSettings {
     }
 }
 
+/// What `rtest.toml` says about the measurement session, for the certificate and the history:
+/// `machine`, `date` (a TOML date or date-time, or a string `YYYY-MM-DD[THH:MM[:SS]][Z]`),
+/// `instrument` and the ambient `temperature_c`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Session {
+    /// Machine name or serial number.
+    pub machine: Option<String>,
+    /// Date (and time) of the measurement, as written (ISO 8601).
+    pub date: Option<String>,
+    /// The measuring instrument (R-Test, probe serial number, …).
+    pub instrument: Option<String>,
+    /// Ambient temperature, °C.
+    pub temperature_c: Option<f64>,
+}
+
+impl Session {
+    /// Seconds since 1970-01-01T00:00:00Z of [`Session::date`] (a date alone is midnight UTC,
+    /// a time without offset UTC).
+    pub fn epoch_s(&self) -> Option<f64> {
+        self.date.as_deref().and_then(|d| epoch_s(d).ok())
+    }
+}
+
+/// Seconds since 1970-01-01T00:00:00Z of an ISO 8601 date or date-time (RFC 3339, the offset
+/// optional: UTC).
+pub fn epoch_s(date: &str) -> Result<f64, String> {
+    let full = if date.len() == 10 {
+        format!("{date}T00:00:00Z")
+    } else if date.ends_with('Z') {
+        date.to_string()
+    } else {
+        format!("{date}Z")
+    };
+    let t = humantime::parse_rfc3339_weak(&full)
+        .or_else(|_| humantime::parse_rfc3339(&full))
+        .map_err(|e| {
+            format!("{date}: not a date (expected YYYY-MM-DD or YYYY-MM-DDTHH:MM:SS, UTC): {e}")
+        })?;
+    t.duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_secs_f64())
+        .map_err(|_| format!("{date}: before 1970"))
+}
+
 /// What a test's data are: one file with both measurements, or one file per measuring system
 /// (each read into one system's [`crate::rtest::clock::Recording`]).
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -157,6 +202,10 @@ struct RawConditions {
     test: Vec<RawTest>,
     tolerances: Option<toml::Table>,
     diagnosis: Option<DiagnosisSettings>,
+    machine: Option<String>,
+    date: Option<toml::Value>,
+    instrument: Option<String>,
+    temperature_c: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -233,6 +282,7 @@ impl TestConditions {
             bad(&m.key, m.message)
         })?;
         check_radius(raw.radius_mm, "radius_mm", &bad)?;
+        let session = session(&raw, &bad)?;
         check_position(raw.position_mm.as_deref(), "position_mm", &bad)?;
         let map = |t: &Option<BTreeMap<String, ColumnEntry>>, table: &str| match t {
             Some(entries) => ColumnMap::from_entries(entries, name, table),
@@ -270,9 +320,52 @@ impl TestConditions {
             tests,
             tolerances,
             diagnosis,
+            session,
             file: None,
         })
     }
+}
+
+fn session(
+    raw: &RawConditions,
+    bad: &dyn Fn(&str, String) -> MeasuredError,
+) -> Result<Session, MeasuredError> {
+    let date = match &raw.date {
+        None => None,
+        Some(toml::Value::Datetime(d)) => Some(d.to_string()),
+        Some(toml::Value::String(s)) => Some(s.trim().to_string()),
+        Some(other) => {
+            return Err(bad(
+                "date",
+                format!(
+                    "expected a date such as 2026-03-14, found {}",
+                    other.type_str()
+                ),
+            ))
+        }
+    };
+    if let Some(d) = &date {
+        epoch_s(d).map_err(|m| bad("date", m))?;
+    }
+    if let Some(t) = raw.temperature_c {
+        if !(t.is_finite() && (-50.0..=100.0).contains(&t)) {
+            return Err(bad(
+                "temperature_c",
+                format!("{} °C must lie in −50 to 100", crate::text::num(t)),
+            ));
+        }
+    }
+    let text = |v: &Option<String>| {
+        v.as_ref()
+            .map(|s| s.trim().to_string())
+            .filter(|s| !s.is_empty())
+    };
+    Ok(Session {
+        machine: text(&raw.machine),
+        date,
+        instrument: text(&raw.instrument),
+        temperature_c: raw.temperature_c,
+    })
 }
 
 fn check_radius(

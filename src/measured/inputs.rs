@@ -6,7 +6,7 @@ use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
 use super::conditions::{
-    folder_of, DataFiles, DiagnosisSettings, TestConditions, TestEntry, MAX_TESTS,
+    folder_of, DataFiles, DiagnosisSettings, Session, TestConditions, TestEntry, MAX_TESTS,
 };
 use super::error::MeasuredError;
 use super::layout::ColumnMap;
@@ -50,6 +50,8 @@ pub struct TestInput {
     pub tolerances: Tolerances,
     /// Settings of its diagnosis (`[diagnosis]`).
     pub diagnosis: DiagnosisSettings,
+    /// Machine, date, instrument and temperature of its measurement.
+    pub session: Session,
 }
 
 impl TestInput {
@@ -111,6 +113,7 @@ impl TestInput {
             external_columns: cond.external_columns.clone(),
             tolerances: cond.tolerances.clone(),
             diagnosis: cond.diagnosis,
+            session: cond.session.clone(),
         }
     }
 

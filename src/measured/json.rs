@@ -153,6 +153,12 @@ pub struct TestJson {
     /// The conditions' note.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub note: Option<String>,
+    /// The machine, where `rtest.toml` names it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub machine: Option<String>,
+    /// Date of the measurement, where `rtest.toml` gives it (ISO 8601).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub date: Option<String>,
 }
 
 /// How a clock offset was found.

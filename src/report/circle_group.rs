@@ -7,17 +7,21 @@
 
 use std::fmt::Write as _;
 
+use super::diagnosis_html::{breakdown_html, READING_NOTE};
 use super::labels::{feed_mm_min, folder_and_name, position_label};
 use super::page::{escape, Figure, Page};
 use super::polar::{self, PolarFigure, PolarPath, PolarScale};
 use super::{short, ReportError};
+use crate::measured::suite::diagnose::SuiteDiagnosis;
 use crate::measured::suite::{Bidirectional, EvaluatedTest, Suite};
 use crate::rtest::iso230::PathFigures;
 
-/// One group: its tests (indices into the suite, cw before ccw) and their G(b) where they pair.
+/// One group: its tests (cw before ccw) and their G(b) where they pair.
 pub struct CircleGroup<'a> {
     /// The tests.
     pub tests: Vec<&'a EvaluatedTest>,
+    /// Their indices in the suite.
+    pub indices: Vec<usize>,
     /// G(b) of the pair.
     pub bidirectional: Option<&'a Bidirectional>,
     /// The paths in polar form: external, internal.
@@ -60,6 +64,7 @@ fn group<'a>(
     let paths = [polar(true)?, polar(false)?];
     Ok(CircleGroup {
         tests,
+        indices: idx,
         bidirectional: pair,
         paths,
     })
@@ -256,13 +261,15 @@ pub fn iso_table(g: &CircleGroup) -> String {
     h
 }
 
-/// The circle plots of the page: per plane a heading, per group the polar plot with its ISO
-/// table beside it and the out-of-plane plot below.
+/// The circle plots of the page: per plane a heading, per group the polar plot with, beside
+/// it, each test's verdict and breakdown by source (where `diagnosis` is given), the ISO table
+/// and the out-of-plane plot.
 pub fn section(
     page: &mut Page,
     groups: &[CircleGroup],
     figures: &[[Figure; 2]],
     scale: &PolarScale,
+    diagnosis: Option<&SuiteDiagnosis>,
 ) {
     page.push(&format!(
         "<p class=\"note\">cw (blue) and ccw (orange) of one plane, acceleration and circle centre \
@@ -274,6 +281,9 @@ pub fn section(
          single test with its fitted ellipses (paper Fig. 5, 8): <code>eij evaluate FILE --plot F.svg</code>.</p>\n",
         short(scale.ring_um, 3)
     ));
+    if diagnosis.is_some() {
+        page.push(&format!("<p class=\"note\">{}</p>\n", escape(READING_NOTE)));
+    }
     let mut plane = None;
     for (g, [polar_fig, oop]) in groups.iter().zip(figures) {
         let p = g.tests[0].result.plane;
@@ -285,7 +295,18 @@ pub fn section(
             );
             plane = Some(p);
         }
-        let beside = iso_table(g) + &super::page::figure_html(oop);
+        let mut beside = String::new();
+        if let Some(d) = diagnosis {
+            for (&i, t) in g.indices.iter().zip(&g.tests) {
+                beside.push_str(&breakdown_html(
+                    &d.tests[i],
+                    d.verdicts[i].as_ref(),
+                    &test_label(t),
+                ));
+            }
+        }
+        beside.push_str(&iso_table(g));
+        beside.push_str(&super::page::figure_html(oop));
         page.figure_beside(polar_fig, &beside);
     }
 }

@@ -8,20 +8,24 @@
 //! Everything is read, evaluated and drawn before the page is written, atomically: `report.html`
 //! is the only file the report writes into its folder.
 
-use std::collections::BTreeSet;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use super::labels::{feed_mm_min, fmt_eij, folder_and_name, folders_of, position_label};
+use super::labels::{
+    conditions_line, distinct, feed_mm_min, fmt_eij, folder_and_name, folders_of, position_label,
+    test_name,
+};
 pub use super::page::Figure;
 use super::page::{anchor, escape, Page};
 use super::verdict::{self, LoadedIdent};
 use super::{
-    circle_group, compare, ident_html, move_svg, short, Conditions, MoveData, ReportError,
+    certificate, circle_group, compare, diagnosis_html, ident_html, move_svg, short, Conditions,
+    MoveData, ReportError,
 };
 use crate::axes::Plane;
 use crate::ident::report::IdentReport;
 use crate::measured::inputs::MeasuredInputs;
+use crate::measured::suite::diagnose::SuiteDiagnosis;
 use crate::measured::suite::{EvaluatedTest, Suite};
 
 /// The report page's file name.
@@ -40,15 +44,6 @@ pub struct ReportRequest {
     pub extra_figures: Vec<Figure>,
     /// The report folder (created if missing; an existing file there is refused).
     pub out_dir: PathBuf,
-}
-
-/// The name of a test with its circle centre: `pos-a/xy_ccw_2.csv @ 150,-100,0 mm`.
-fn test_name(t: &EvaluatedTest) -> String {
-    let name = folder_and_name(t.input.primary_file());
-    match &t.input.position_mm {
-        Some(p) => format!("{name} @ {} mm", position_label(p)),
-        None => name,
-    }
 }
 
 /// Reads an identify report, naming the file and the key on failure.
@@ -117,6 +112,14 @@ pub fn generate(req: &ReportRequest) -> Result<PathBuf, ReportError> {
     let measured = MeasuredInputs::expand(&req.measured)?;
     let files = measured.data_files();
     let suite = crate::measured::suite::evaluate_tests(&measured.tests, &Default::default())?;
+    // A test the diagnosis cannot decompose does not stop the report: the page says so.
+    let diagnosis = (!suite.tests.is_empty())
+        .then(|| crate::measured::suite::diagnose::diagnose(&suite, Default::default()));
+    let (diagnosis, diagnosis_error) = match diagnosis {
+        Some(Ok(d)) => (Some(d), None),
+        Some(Err(e)) => (None, Some(e.to_string())),
+        None => (None, None),
+    };
     let groups = circle_group::groups(&suite)?;
     let scale = circle_group::page_scale(&groups);
     let circle_figures = groups
@@ -163,6 +166,28 @@ pub fn generate(req: &ReportRequest) -> Result<PathBuf, ReportError> {
 
     let mut page = Page::default();
     verdict_section(&mut page, &idents, &suite);
+    if let Some(e) = &diagnosis_error {
+        page.push(&format!(
+            "<p class=\"warn\">The circle diagnosis could not be made: {}</p>\n",
+            escape(e)
+        ));
+    }
+    if let Some(d) = &diagnosis {
+        page.push(&tolerance_verdict_html(d, &suite));
+    }
+    if !suite.tests.is_empty() {
+        certificate::certificate(
+            &mut page,
+            &certificate::CertificateInput {
+                suite: &suite,
+                diagnosis: diagnosis.as_ref(),
+                machines_elsewhere: machines(&idents),
+                written: format!("{date} by eij {}", env!("CARGO_PKG_VERSION")),
+                conditions: conditions_line(&suite.tests),
+                folders: folders_of(files.iter().map(PathBuf::as_path)).join("; "),
+            },
+        );
+    }
     if idents.len() > 1 {
         compare::comparison(&mut page, &idents);
     }
@@ -171,7 +196,13 @@ pub fn generate(req: &ReportRequest) -> Result<PathBuf, ReportError> {
         let mut h = String::new();
         circle_tables(&mut h, &suite.tests);
         page.push(&h);
-        circle_group::section(&mut page, &groups, &circle_figures, &scale);
+        circle_group::section(
+            &mut page,
+            &groups,
+            &circle_figures,
+            &scale,
+            diagnosis.as_ref(),
+        );
     }
     if !moves.is_empty() {
         page.heading(2, "moves", "Positioning moves");
@@ -244,20 +275,6 @@ fn title(idents: &[LoadedIdent]) -> String {
     }
 }
 
-/// Distinct values, formatted, in ascending order.
-fn distinct(values: impl Iterator<Item = f64>, decimals: usize) -> String {
-    let mut v: Vec<f64> = values.filter(|v| v.is_finite()).collect();
-    v.sort_by(f64::total_cmp);
-    let mut out: Vec<String> = Vec::new();
-    for x in v {
-        let s = short(x, decimals);
-        if !out.contains(&s) {
-            out.push(s);
-        }
-    }
-    out.join(", ")
-}
-
 /// The header: machine, date, version, data folders, conditions of the tests.
 fn header_html(
     req: &ReportRequest,
@@ -267,11 +284,19 @@ fn header_html(
     date: &str,
 ) -> String {
     let mut rows: Vec<(&str, String)> = Vec::new();
-    let machines = machines(idents);
+    let mut machines = machines(idents);
+    for t in &suite.tests {
+        if let Some(m) = &t.input.session.machine {
+            if !machines.contains(m) {
+                machines.push(m.clone());
+            }
+        }
+    }
     rows.push((
         "machine",
         if machines.is_empty() {
-            "not stated (the measured files do not name it; an identify report would)".into()
+            "not stated (give machine = \"…\" in rtest.toml; an identify report names it too)"
+                .into()
         } else {
             machines.join(", ")
         },
@@ -291,35 +316,8 @@ fn header_html(
             folders_of(files.iter().map(PathBuf::as_path)).join("; ")
         },
     ));
-    let t = &suite.tests;
-    if !t.is_empty() {
-        let planes: BTreeSet<String> = t.iter().map(|t| t.result.plane.to_string()).collect();
-        let dirs: BTreeSet<String> = t.iter().map(|t| t.result.direction.to_string()).collect();
-        let centres: BTreeSet<String> = t
-            .iter()
-            .map(|t| {
-                t.input
-                    .position_mm
-                    .as_deref()
-                    .map_or("not stated".into(), |p| {
-                        format!("[{}] mm", position_label(p))
-                    })
-            })
-            .collect();
-        rows.push((
-            "conditions",
-            format!(
-                "{} circle tests; planes {}; directions {}; set radius {} mm; set acceleration {} m/s²; feed {} mm/min; circle centres (axis positions) {}",
-                t.len(),
-                planes.into_iter().collect::<Vec<_>>().join(", "),
-                dirs.into_iter().collect::<Vec<_>>().join(", "),
-                distinct(t.iter().map(|t| t.result.radius_mm), 4),
-                distinct(t.iter().map(|t| t.result.accel_m_s2), 1),
-                // To 10 mm/min: the programmed feeds, not the last digit of ω.
-                distinct(t.iter().map(|t| (feed_mm_min(&t.result) / 10.0).round() * 10.0), 0),
-                centres.into_iter().collect::<Vec<_>>().join(", ")
-            ),
-        ));
+    if !suite.tests.is_empty() {
+        rows.push(("conditions", conditions_line(&suite.tests)));
     }
     if !req.moves.is_empty() {
         rows.push((
@@ -372,6 +370,41 @@ fn verdict_section(page: &mut Page, idents: &[LoadedIdent], suite: &Suite) {
         .collect();
     h.push_str(&verdict::circle_warnings_html(&tests, &suite.warnings));
     page.push(&h);
+}
+
+/// The tolerance verdict of the circle tests: overall, and each failed test with its checks.
+fn tolerance_verdict_html(d: &SuiteDiagnosis, suite: &Suite) -> String {
+    let judged = d.verdicts.iter().flatten().count();
+    let Some(v) = d.verdict() else {
+        return "<p><b>Tolerances:</b> none given (<code>[tolerances]</code> in rtest.toml): \
+                the circle tests are diagnosed, not judged.</p>\n"
+            .into();
+    };
+    let failed = d.failed();
+    let mut h = format!(
+        "<p><b>Tolerances:</b> {} {} of {judged} judged circle tests within tolerance \
+         (<a href=\"#{}\">certificate</a>)</p>\n",
+        diagnosis_html::badge(Some(v)),
+        judged - failed.len(),
+        certificate::ID
+    );
+    if !failed.is_empty() {
+        h.push_str("<ul class=\"warn\">\n");
+        for i in failed {
+            let checks = d.verdicts[i]
+                .as_ref()
+                .map_or(Vec::new(), diagnosis_html::failed_checks);
+            let _ = writeln!(
+                h,
+                "<li class=\"{}\">{}: {}</li>",
+                diagnosis_html::FAIL,
+                escape(&test_name(&suite.tests[i])),
+                escape(&checks.join("; "))
+            );
+        }
+        h.push_str("</ul>\n");
+    }
+    h
 }
 
 /// EIJ of each move (`eij evaluate-move`) beside the mean of the circle tests that accelerate

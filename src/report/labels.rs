@@ -2,10 +2,69 @@
 //! test files as `folder/name`, data folders with their file counts, EIJ values, circle centres,
 //! a test's path speed.
 
+use std::collections::BTreeSet;
 use std::path::Path;
 
 use super::short;
+use crate::measured::suite::EvaluatedTest;
 use crate::rtest::CircleResult;
+
+/// The name of a test with its circle centre: `pos-a/xy_ccw_2.csv @ 150,-100,0 mm`.
+pub fn test_name(t: &EvaluatedTest) -> String {
+    let name = folder_and_name(t.input.primary_file());
+    match &t.input.position_mm {
+        Some(p) => format!("{name} @ {} mm", position_label(p)),
+        None => name,
+    }
+}
+
+/// Distinct values, formatted, in ascending order.
+pub fn distinct(values: impl Iterator<Item = f64>, decimals: usize) -> String {
+    let mut v: Vec<f64> = values.filter(|v| v.is_finite()).collect();
+    v.sort_by(f64::total_cmp);
+    let mut out: Vec<String> = Vec::new();
+    for x in v {
+        let s = short(x, decimals);
+        if !out.contains(&s) {
+            out.push(s);
+        }
+    }
+    out.join(", ")
+}
+
+/// The conditions of a set of tests in one line: count, planes, directions, set radius,
+/// accelerations, feeds and circle centres.
+pub fn conditions_line(t: &[EvaluatedTest]) -> String {
+    let planes: BTreeSet<String> = t.iter().map(|t| t.result.plane.to_string()).collect();
+    let dirs: BTreeSet<String> = t.iter().map(|t| t.result.direction.to_string()).collect();
+    let centres: BTreeSet<String> = t
+        .iter()
+        .map(|t| {
+            t.input
+                .position_mm
+                .as_deref()
+                .map_or("not stated".into(), |p| {
+                    format!("[{}] mm", position_label(p))
+                })
+        })
+        .collect();
+    format!(
+        "{} circle tests; planes {}; directions {}; set radius {} mm; set acceleration {} m/s²; \
+         feed {} mm/min; circle centres (axis positions) {}",
+        t.len(),
+        planes.into_iter().collect::<Vec<_>>().join(", "),
+        dirs.into_iter().collect::<Vec<_>>().join(", "),
+        distinct(t.iter().map(|t| t.result.radius_mm), 4),
+        distinct(t.iter().map(|t| t.result.accel_m_s2), 1),
+        // To 10 mm/min: the programmed feeds, not the last digit of ω.
+        distinct(
+            t.iter()
+                .map(|t| (feed_mm_min(&t.result) / 10.0).round() * 10.0),
+            0
+        ),
+        centres.into_iter().collect::<Vec<_>>().join(", ")
+    )
+}
 
 /// `folder/name` of a path: the name alone is ambiguous when several folders (test positions)
 /// hold files of the same name.

@@ -10,6 +10,8 @@
 //! cw/ccw pairs (measured::suite) ─► circle_group ─► polar_svg (ISO 230-4 circle plot, µm rings)
 //!                                             └► polar::out_of_plane_svg (cw and ccw over φ)
 //! identify reports ─► verdict (standing, χ², warnings), compare (side by side)
+//! measured::suite::diagnose ─► diagnosis_html (per test and source, beside the circle plot)
+//!                           └► certificate (one A4 page: machine, date, tolerances, pass/fail)
 //! all of it ─► html::generate ─► DIR/report.html (figures inline, page::Page)
 //! ```
 //!
@@ -24,9 +26,11 @@
 use crate::measured::conditions::TestConditions;
 use std::path::Path;
 
+pub mod certificate;
 pub mod circle;
 pub mod circle_group;
 pub mod compare;
+pub mod diagnosis_html;
 pub mod html;
 pub mod ident_html;
 pub mod ident_plot;

@@ -79,7 +79,26 @@ ul.warn li{color:#a33;font-size:13px;margin:3px 0}\
 .warn{color:#a33;font-size:13px}\
 nav.toc{font-size:14px;columns:2;border:1px solid #ddd;padding:6px 12px;margin:10px 0}\
 nav.toc ul{margin:0;padding-left:18px}nav.toc li{break-inside:avoid}\
-p.note{font-size:13px;color:#444}";
+p.note{font-size:13px;color:#444}\
+.badge{display:inline-block;padding:1px 8px;border-radius:3px;font-weight:bold;font-size:13px;color:#fff}\
+.badge.v-pass{background:#1f6f1f}.badge.v-fail{background:#b22}.badge.v-none{background:#777}\
+p.v-fail,li.v-fail{color:#b22}\
+td.v-pass{background:#e3f1e3;color:#1f6f1f}td.v-fail{background:#f9e0e0;color:#b22;font-weight:bold}\
+td.ns{color:#999}table.diag td small{color:#555}\
+div.diag{margin:0 0 14px 0}p.diag-head{margin:4px 0;font-size:14px}\
+ul.notes{font-size:12px;color:#444;margin:2px 0;padding-left:18px}\
+.certificate{border:1px solid #bbb;padding:2px 14px 8px 14px;margin:14px 0}\
+table.cert{font-size:12px}table.cert td,table.cert th{padding:2px 5px}\
+p.cert-verdict{font-size:16px}p.sign{margin-top:18px;font-size:13px}\
+@page{size:A4;margin:12mm}\
+@media print{body{margin:0;max-width:none;font-size:11px;-webkit-print-color-adjust:exact;print-color-adjust:exact}\
+nav.toc{display:none}h2{margin-top:14px}figure,table,div.diag{break-inside:avoid}h2,h3,h4{break-after:avoid}\
+.row{display:block}svg.fig{max-width:100%}\
+.certificate{break-before:page;break-after:page;border:none;padding:0;margin:0}\
+.certificate h2{font-size:17px;margin:0 0 4px 0}.certificate table.head{font-size:10px}\
+.certificate p{margin:4px 0}.certificate p.note{font-size:9px}p.cert-verdict{font-size:13px}\
+table.cert{font-size:9.5px;margin:4px 0 6px 0}table.cert td,table.cert th{padding:0 3px}\
+table.cert td.w{max-width:260px}.certificate .badge{font-size:9px;padding:0 4px}}";
 
 /// A page under construction: the body text and the headings for the table of contents.
 #[derive(Debug, Default)]

@@ -369,7 +369,7 @@ fn pairs(tests: &[EvaluatedTest]) -> Vec<Bidirectional> {
 impl EvaluatedTest {
     /// The test's JSON object: [`CircleResult::to_json`] plus `radius_source`, and where known
     /// `time_offset_ms` with `time_offset` (`std_err_ms`, `source`, `clock`, `alignment_ms`),
-    /// `position_mm` and `note`.
+    /// `position_mm`, `note`, `machine` and `date`.
     pub fn to_json(&self) -> serde_json::Value {
         serde_json::to_value(self.to_typed()).unwrap_or(serde_json::Value::Null)
     }
@@ -390,6 +390,8 @@ impl EvaluatedTest {
             }),
             position_mm: self.input.position_mm.clone(),
             note: self.input.note.clone(),
+            machine: self.input.session.machine.clone(),
+            date: self.input.session.date.clone(),
         }
     }
 }

@@ -172,6 +172,22 @@ pub struct Term {
     pub verdict: Option<&'static str>,
 }
 
+/// A term stands out of its noise beyond this many standard errors…
+pub const STANDS_OUT_SE: f64 = 3.0;
+/// …and changes G (or the out-of-plane range) by at least this, µm.
+pub const STANDS_OUT_UM: f64 = 0.01;
+
+impl Term {
+    /// Whether the term is worth showing: it has a limit, or it stands out of its noise
+    /// (|value| > [`STANDS_OUT_SE`] standard errors) and changes its figure by at least
+    /// [`STANDS_OUT_UM`].
+    pub fn stands_out(&self) -> bool {
+        self.limit.is_some()
+            || (self.value.abs() > STANDS_OUT_SE * self.std_err
+                && self.contribution_um >= STANDS_OUT_UM)
+    }
+}
+
 /// The decomposition of one source of one test.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SourceDiagnosis {
