@@ -4,7 +4,7 @@ mod common;
 
 use common::synth::Synth;
 use eij::axes::Plane;
-use eij::rtest::{evaluate, evaluate_pooled, CircleSeries, EvalOptions, RtestError};
+use eij::rtest::{evaluate, evaluate_pooled, CircleSeries, EvalOptions, RtestError, Warning};
 
 /// Static geometry: a radial/elliptic deviation (G_aa, G_bb), a skew (G_ab, G_ba) and a tilt
 /// of the circle plane (G_ka, G_kb), µm per mm of set position.
@@ -136,7 +136,9 @@ fn cw_ccw_inconsistency_is_flagged() {
     let z = p.cw_ccw_difference_sigma[&eij::axes::Eij::new(eij::axes::Axis::Z, eij::axes::Axis::X)];
     assert!(z < -3.0, "z = {z}");
     assert!(
-        p.warnings.iter().any(|w| w.starts_with("EZX")),
+        p.warnings.iter().any(
+            |w| matches!(w, Warning::CwCcwDiffer { eij, z, .. } if eij.name() == "EZX" && *z < -3.0)
+        ),
         "{:?}",
         p.warnings
     );

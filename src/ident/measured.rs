@@ -9,6 +9,7 @@ use crate::measured::inputs::{MeasuredInputs, TestInput};
 use crate::measured::suite::{evaluate_tests, ClockReport, SuiteOptions};
 use crate::measured::table;
 use crate::predict::CircleTest;
+use crate::rtest::{Named, Warning};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
@@ -28,7 +29,7 @@ pub struct Measured {
     pub tests: Vec<TestCase>,
     /// What the evaluation says about conditions and clocks, naming the test or clock; and,
     /// with [`MeasuredOptions::fit_time_offset`], which tests' clock offset is not separable.
-    pub warnings: Vec<String>,
+    pub warnings: Vec<Named>,
     /// The clocks whose offsets the evaluation estimated (applied to single-file tests with
     /// [`MeasuredOptions::fit_time_offset`]; two-system recordings are always aligned).
     pub clocks: Vec<ClockReport>,
@@ -63,21 +64,19 @@ pub fn load_measured(
             .map(|t| t.input.name())
             .collect();
         if !unseparated.is_empty() {
-            warnings.push(format!(
-                "the clock offset between scales and R-Test is not separable from cross-talk for {} test(s) ({}{}): a probe-logger lag there would pass as antisymmetric in-plane cross-talk (separable with cw and ccw at one acceleration, or three circle speeds, per folder)",
-                unseparated.len(),
-                unseparated.iter().take(3).cloned().collect::<Vec<_>>().join(", "),
-                if unseparated.len() > 3 { ", …" } else { "" }
-            ));
+            warnings.push(Named {
+                name: None,
+                warning: Warning::ClockOffsetNotSeparable { tests: unseparated },
+            });
         }
     }
     let clocks = suite.clocks;
-    warnings.extend(
-        suite
-            .tests
-            .iter()
-            .flat_map(|t| t.notes.iter().map(|n| format!("{}: {n}", t.input.name()))),
-    );
+    warnings.extend(suite.tests.iter().flat_map(|t| {
+        t.notes.iter().map(|n| Named {
+            name: Some(t.input.name()),
+            warning: n.clone(),
+        })
+    }));
     let mut evaluated = suite.tests.into_iter();
     let mut tests = Vec::new();
     for input in inputs {

@@ -127,7 +127,7 @@ impl From<&CircleResult> for CircleJson {
                 external: path(&iso.external),
             }),
             iso230_4: r.iso230,
-            warnings: r.warnings.clone(),
+            warnings: r.warnings.iter().map(ToString::to_string).collect(),
         }
     }
 }

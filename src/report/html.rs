@@ -366,9 +366,13 @@ fn verdict_section(page: &mut Page, idents: &[LoadedIdent], suite: &Suite) {
     let tests: Vec<(String, Vec<String>)> = suite
         .tests
         .iter()
-        .map(|t| (test_name(t), t.result.warnings.clone()))
+        .map(|t| {
+            let warnings = t.result.warnings.iter().map(ToString::to_string);
+            (test_name(t), warnings.collect())
+        })
         .collect();
-    h.push_str(&verdict::circle_warnings_html(&tests, &suite.warnings));
+    let set: Vec<String> = suite.warnings.iter().map(ToString::to_string).collect();
+    h.push_str(&verdict::circle_warnings_html(&tests, &set));
     page.push(&h);
 }
 

@@ -49,10 +49,12 @@ pub mod moves;
 pub mod normalise;
 pub mod pooled;
 pub mod series;
+pub mod warning;
 
 pub use error::{Line, Location, RtestError};
 pub use pooled::{evaluate_pooled, PooledResult};
 pub use series::CircleSeries;
+pub use warning::{Named, Warning};
 
 /// Options of [`evaluate`]; `None` means "infer from the data".
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -103,8 +105,9 @@ pub struct CircleResult {
     pub iso230: Option<iso230::CircleFigures>,
     /// The steady whole revolutions as sample indices of the series.
     pub steady: std::ops::Range<usize>,
-    /// Disagreements between the routes beyond noise (see [`evaluate`]).
-    pub warnings: Vec<String>,
+    /// Disagreements between the routes beyond noise (see [`evaluate`]); a suite of measured
+    /// tests adds what their conditions say ([`crate::measured::suite`]).
+    pub warnings: Vec<Warning>,
 }
 
 /// The fast path for repeated use (e.g. inside identification): normalisation and the joint
@@ -155,23 +158,26 @@ pub fn evaluate(series: &CircleSeries, opts: &EvalOptions) -> Result<CircleResul
         |p: &Eij| 3.0 * std::f64::consts::SQRT_2 * joint.eij[p].std_err + RESOLUTION_UM_S2_PER_M;
     let mut warnings = Vec::new();
     for (p, route) in &plane_fit {
-        let (v, j, s) = (route.value, joint.eij[p].value, joint.eij[p].std_err);
-        if (v - j).abs() > tolerance(p) {
-            warnings.push(format!(
-                "plane fit {p} = {v:.4} differs from the joint fit {j:.4} ± {s:.4} µm·s²/m"
-            ));
+        if (route.value - joint.eij[p].value).abs() > tolerance(p) {
+            warnings.push(Warning::PlaneFitDiffers {
+                eij: *p,
+                plane_fit: route.value,
+                joint: joint.eij[p],
+            });
         }
     }
     match &ellipse {
-        None => warnings.push("ellipse fit failed: a path is not an ellipse".into()),
+        None => warnings.push(Warning::EllipseFitFailed),
         Some(route) => {
             for (p, v) in &route.eij {
-                let (j, s) = (route.predicted_from_joint[p], joint.eij[p].std_err);
-                if (v - j).abs() > tolerance(p) {
-                    warnings.push(format!(
-                        "ellipse fit {p} = {v:.4} differs from {j:.4} ± {s:.4} µm·s²/m expected \
-                         from the joint fit"
-                    ));
+                let expected = route.predicted_from_joint[p];
+                if (v - expected).abs() > tolerance(p) {
+                    warnings.push(Warning::EllipseFitDiffers {
+                        eij: *p,
+                        ellipse_fit: *v,
+                        expected,
+                        std_err: joint.eij[p].std_err,
+                    });
                 }
             }
         }

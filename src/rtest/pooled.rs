@@ -8,7 +8,7 @@ use nalgebra::DMatrix;
 use super::error::{Location, RtestError};
 use super::lstsq::{lstsq, Lstsq};
 use super::normalise::{normalise, Normalised};
-use super::{CircleSeries, EvalOptions};
+use super::{CircleSeries, EvalOptions, Warning};
 use crate::axes::{Axis, Direction, Eij, EijEstimates, EijMap, Plane};
 
 /// Accelerations closer than this ratio count as one.
@@ -38,7 +38,7 @@ pub struct PooledResult {
     /// two or more accelerations; empty otherwise.
     pub cw_ccw_difference_sigma: EijMap,
     /// Inconsistencies worth a look (cw/ccw beyond 3 combined standard errors, ...).
-    pub warnings: Vec<String>,
+    pub warnings: Vec<Warning>,
 }
 
 /// Pooled fit over several circle tests of one plane, per axis i = a, b, k:
@@ -137,20 +137,17 @@ pub fn evaluate_pooled(
                     let (c, cc) = (e_cw[&p], e_ccw[&p]);
                     let z = (c.value - cc.value) / c.std_err.hypot(cc.std_err);
                     if z.abs() > 3.0 {
-                        warnings.push(format!(
-                            "{p}: cw {:.4} and ccw {:.4} µm·s²/m differ by {z:.1} combined \
-                             standard errors",
-                            c.value, cc.value
-                        ));
+                        warnings.push(Warning::CwCcwDiffer {
+                            eij: p,
+                            cw: c.value,
+                            ccw: cc.value,
+                            z,
+                        });
                     }
                     cw_ccw.insert(p, z);
                 }
             }
-            _ => warnings.push(
-                "cw/ccw consistency not checked: each direction needs tests at two or more \
-                 accelerations"
-                    .into(),
-            ),
+            _ => warnings.push(Warning::CwCcwNotChecked),
         }
     }
     Ok(PooledResult {
