@@ -1,6 +1,7 @@
 //! Names shared along the whole data path: machine axes, circle planes, directions and the
 //! EIJ parameters (ISO 230-1 notation with the acceleration dot left out).
 
+use std::collections::{btree_map, BTreeMap};
 use std::fmt;
 use std::str::FromStr;
 
@@ -254,6 +255,123 @@ impl FromStr for Eij {
     }
 }
 
+/// EIJ values alone, by parameter, µm·s²/m: what a simulation predicts, or one route of an
+/// evaluation; measured values travel with their standard errors as [`EijEstimates`].
+pub type EijMap = BTreeMap<Eij, f64>;
+
+/// A value estimated from data, with its standard error (in the value's unit).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Estimate {
+    /// The estimate.
+    pub value: f64,
+    /// Its standard error.
+    pub std_err: f64,
+}
+
+/// EIJ estimated from data, each with its standard error, by parameter: what an evaluation of a
+/// circle test or a move gives, and what an identification fits the model to. µm·s²/m (the
+/// geometric terms of a pooled evaluation: µm per mm of set position).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct EijEstimates(BTreeMap<Eij, Estimate>);
+
+impl EijEstimates {
+    /// No estimates yet.
+    pub fn new() -> Self {
+        EijEstimates(BTreeMap::new())
+    }
+
+    /// Values that share one standard error (e.g. simulated EIJ taken as measured with a
+    /// given uncertainty).
+    pub fn with_std_err(values: impl IntoIterator<Item = (Eij, f64)>, std_err: f64) -> Self {
+        values
+            .into_iter()
+            .map(|(p, value)| (p, Estimate { value, std_err }))
+            .collect()
+    }
+
+    /// Sets the estimate of `eij` (replacing an earlier one).
+    pub fn insert(&mut self, eij: Eij, value: f64, std_err: f64) {
+        self.0.insert(eij, Estimate { value, std_err });
+    }
+
+    /// The estimate of `eij`, if there is one.
+    pub fn get(&self, eij: &Eij) -> Option<&Estimate> {
+        self.0.get(eij)
+    }
+
+    /// The value of `eij`, if estimated.
+    pub fn value(&self, eij: &Eij) -> Option<f64> {
+        self.0.get(eij).map(|e| e.value)
+    }
+
+    /// The standard error of `eij`, if estimated.
+    pub fn std_err(&self, eij: &Eij) -> Option<f64> {
+        self.0.get(eij).map(|e| e.std_err)
+    }
+
+    /// Whether `eij` is estimated.
+    pub fn contains(&self, eij: &Eij) -> bool {
+        self.0.contains_key(eij)
+    }
+
+    /// How many EIJ are estimated.
+    pub fn len(&self) -> usize {
+        self.0.len()
+    }
+
+    /// Whether none is.
+    pub fn is_empty(&self) -> bool {
+        self.0.is_empty()
+    }
+
+    /// The estimated EIJ, in order (`EXX`, `EXY`, … `EZZ`).
+    pub fn keys(&self) -> impl Iterator<Item = Eij> + '_ {
+        self.0.keys().copied()
+    }
+
+    /// Every EIJ with its estimate, in order.
+    pub fn iter(&self) -> btree_map::Iter<'_, Eij, Estimate> {
+        self.0.iter()
+    }
+
+    /// Every EIJ with its estimate to change, in order.
+    pub fn iter_mut(&mut self) -> btree_map::IterMut<'_, Eij, Estimate> {
+        self.0.iter_mut()
+    }
+
+    /// The values alone (for tables and JSON objects of values).
+    pub fn value_map(&self) -> EijMap {
+        self.0.iter().map(|(p, e)| (*p, e.value)).collect()
+    }
+
+    /// The standard errors alone.
+    pub fn std_err_map(&self) -> EijMap {
+        self.0.iter().map(|(p, e)| (*p, e.std_err)).collect()
+    }
+}
+
+impl std::ops::Index<&Eij> for EijEstimates {
+    type Output = Estimate;
+    /// The estimate of an EIJ that must be there (panics otherwise, like a map's index).
+    fn index(&self, eij: &Eij) -> &Estimate {
+        &self.0[eij]
+    }
+}
+
+impl FromIterator<(Eij, Estimate)> for EijEstimates {
+    fn from_iter<T: IntoIterator<Item = (Eij, Estimate)>>(iter: T) -> Self {
+        EijEstimates(iter.into_iter().collect())
+    }
+}
+
+impl<'a> IntoIterator for &'a EijEstimates {
+    type Item = (&'a Eij, &'a Estimate);
+    type IntoIter = btree_map::Iter<'a, Eij, Estimate>;
+    fn into_iter(self) -> Self::IntoIter {
+        self.0.iter()
+    }
+}
+
 /// Serde as the names of files and JSON keys (`x`, `zx`, `ccw`, `EXZ`), through `Display` and
 /// `FromStr`, so that a file is read back with the very names it was written with.
 macro_rules! serde_by_name {
@@ -283,6 +401,26 @@ mod tests {
     fn zx_parameters_follow_the_contract_order() {
         let names: Vec<String> = Plane::Zx.parameters().iter().map(|p| p.name()).collect();
         assert_eq!(names, ["EZZ", "EXX", "EXZ", "EZX", "EYZ", "EYX"]);
+    }
+
+    #[test]
+    fn estimates_keep_value_and_standard_error_together() {
+        let (exz, ezz) = ("EXZ".parse().unwrap(), "EZZ".parse().unwrap());
+        let mut e = EijEstimates::with_std_err([(ezz, -0.34), (exz, -0.28)], 0.02);
+        e.insert(exz, -0.30, 0.05);
+        assert_eq!(e.len(), 2);
+        assert_eq!(
+            e[&exz],
+            Estimate {
+                value: -0.30,
+                std_err: 0.05
+            }
+        );
+        assert_eq!((e.value(&ezz), e.std_err(&ezz)), (Some(-0.34), Some(0.02)));
+        assert_eq!(e.keys().collect::<Vec<_>>(), [exz, ezz]);
+        assert_eq!(e.value_map(), EijMap::from([(exz, -0.30), (ezz, -0.34)]));
+        assert_eq!(e.std_err_map(), EijMap::from([(exz, 0.05), (ezz, 0.02)]));
+        assert!(!e.contains(&"EXX".parse().unwrap()));
     }
 
     #[test]

@@ -105,7 +105,7 @@ pub mod rtest;
 pub mod sim;
 pub mod text;
 
-pub use axes::{Axis, Direction, Eij, Plane};
+pub use axes::{Axis, Direction, Eij, EijEstimates, Estimate, Plane};
 pub use control::ClosedLoop;
 pub use ident::report::{machine_toml, ExportError, Provenance};
 pub use ident::verdict::{Chi2, Standing};

@@ -2,7 +2,7 @@
 //! positions (harmonic steady state, the same simulation and evaluation as the
 //! identification: [`crate::predict`]), as a compensation table position → EIJ.
 
-use crate::axes::{Axis, Direction, Eij, Plane};
+use crate::axes::{Axis, Direction, Eij, EijMap, Plane};
 use crate::machine::Machine;
 use crate::predict::{simulated_eij, CircleTest, PredictError, SimSettings};
 use std::collections::BTreeMap;
@@ -117,7 +117,7 @@ pub struct MapPoint {
     /// Axis positions in machine axis order, m.
     pub position_m: Vec<f64>,
     /// The six EIJ of the plane, µm·s²/m.
-    pub eij: BTreeMap<Eij, f64>,
+    pub eij: EijMap,
 }
 
 /// EIJ over the grid (axes without a grid stay at their reference position), in parallel;

@@ -26,18 +26,16 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-use crate::axes::{Direction, Eij, Plane};
+use crate::axes::{Direction, Plane};
 use crate::control::{ClosedLoop, ControlError, FrequencyForm, PoseChecks};
 use crate::machine::{Machine, Pose, PoseError};
 use crate::rtest::{self, EvalOptions, RtestError};
 use crate::sim::setpoint::Circle;
 use crate::sim::{harmonic, output, simulate_discrete, Discrete, SimError};
 use rayon::prelude::*;
-use std::collections::BTreeMap;
 use std::sync::Arc;
 
-/// EIJ of one test by parameter, µm·s²/m.
-pub type EijMap = BTreeMap<Eij, f64>;
+pub use crate::axes::EijMap;
 
 /// The conditions of one circle test (CONTRACT.md: plane, direction, set radius, set
 /// acceleration a = r·ω², circle centre).
@@ -401,7 +399,7 @@ fn run_test(
                 radius_mm: Some(test.radius_mm),
             };
             let (_, joint) = rtest::evaluate_joint(&series, &opts)?;
-            Ok(joint.eij)
+            Ok(joint.eij.value_map())
         }
         Prepared::Harmonic(form) => {
             let ph = harmonic::circle_phasors_in(

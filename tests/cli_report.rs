@@ -387,8 +387,8 @@ fn report_is_one_self_contained_page_with_the_verdict_first() {
         for p in res.plane.parameters() {
             let cell = format!(
                 "<td>{} ± {}</td>",
-                fmt_eij(res.eij[&p]),
-                fmt_eij(res.std_err[&p])
+                fmt_eij(res.eij[&p].value),
+                fmt_eij(res.eij[&p].std_err)
             );
             assert!(row.contains(&cell), "{f} {p}: {row}");
         }

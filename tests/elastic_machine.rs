@@ -4,7 +4,7 @@
 //! continuous as the Z carriages travel over the column's nodes, and the column's stiffness
 //! identified from EIJ it produced.
 
-use eij::axes::{Axis, Direction, Eij, Plane};
+use eij::axes::{Axis, Direction, Eij, EijEstimates, Plane};
 use eij::ident::{identify, Parameter, Problem, Settings, TestCase};
 use eij::machine::catalogue::Catalogue;
 use eij::machine::elastic::FeBody;
@@ -213,7 +213,7 @@ fn the_column_stiffness_is_identified_from_the_eij_it_produced() {
         .unwrap()
         .remove(0);
     for (t, sim) in tests.iter_mut().zip(sims) {
-        t.measured = sim.into_iter().map(|(k, v)| (k, (v, 0.02))).collect();
+        t.measured = EijEstimates::with_std_err(sim, 0.02);
     }
     let problem = Problem::new(machine, params, tests, settings).unwrap();
     let result = identify(&problem, None).unwrap();

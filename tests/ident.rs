@@ -1,6 +1,6 @@
 //! Identification against synthetic data with known reduction factors.
 
-use eij::axes::{Direction, Plane};
+use eij::axes::{Direction, EijEstimates, Plane};
 use eij::ident::{identify, IdentError, Parameter, Problem, Settings, TestCase};
 use eij::machine::Machine;
 use eij::predict::{simulated_eij, CircleTest};
@@ -32,7 +32,7 @@ fn synthetic(truth: &Machine, tests: &mut [TestCase], settings: &Settings) {
         .unwrap()
         .remove(0);
     for (t, sim) in tests.iter_mut().zip(sims) {
-        t.measured = sim.into_iter().map(|(k, v)| (k, (v, 0.02))).collect();
+        t.measured = EijEstimates::with_std_err(sim, 0.02);
     }
 }
 
@@ -149,7 +149,8 @@ fn tests_without_values_or_in_a_plane_the_model_lacks_are_refused() {
     tests[0].circle.position_m = None;
     tests[0].measured.insert(
         eij::axes::Eij::new(eij::axes::Axis::X, eij::axes::Axis::X),
-        (-1.0, 0.02),
+        -1.0,
+        0.02,
     );
     let err = Problem::new(
         single.clone(),
@@ -199,9 +200,9 @@ fn noisy_demo_set_recovers_the_generator_truth_within_three_standard_errors() {
     );
     // Catalogue model under-predicts the in-talk by a factor 2–3 before, not after.
     let t = &problem.tests()[0];
-    let (e, (m, _)) = t.measured.iter().find(|(e, _)| e.is_in_talk()).unwrap();
-    let before = result.simulated_initial[0][e] / m;
-    let after = result.simulated_final[0][e] / m;
+    let (e, m) = t.measured.iter().find(|(e, _)| e.is_in_talk()).unwrap();
+    let before = result.simulated_initial[0][e] / m.value;
+    let after = result.simulated_final[0][e] / m.value;
     assert!(before > 0.3 && before < 0.5, "catalogue/measured {before}");
     assert!((after - 1.0).abs() < 0.05, "identified/measured {after}");
 }

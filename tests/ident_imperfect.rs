@@ -179,8 +179,8 @@ fn a_trial_step_that_cannot_be_simulated_is_rejected_not_fatal() {
     )
     .unwrap();
     for t in &mut tests {
-        for v in t.measured.values_mut() {
-            v.1 *= 0.1;
+        for (_, v) in t.measured.iter_mut() {
+            v.std_err *= 0.1;
         }
     }
     let params = vec![Parameter::parse("z.screw", &base).unwrap()];

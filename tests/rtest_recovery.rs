@@ -27,7 +27,7 @@ fn noise_free_recovery_is_exact() {
                 assert!((r.accel_m_s2 - accel).abs() < 1e-9 * accel);
                 assert_eq!(r.revolutions, 5);
                 for (p, truth) in syn.truth() {
-                    let got = r.eij[&p];
+                    let got = r.eij[&p].value;
                     assert!(
                         (got - truth).abs() < 1e-9,
                         "{plane} ccw={ccw} a={accel}: {p} = {got}, truth {truth}"
@@ -64,7 +64,7 @@ fn noisy_recovery_within_three_standard_errors() {
                 let n = r.samples_used as f64;
                 let expected_se = syn.noise_um * (2.0 / n).sqrt() / accel;
                 for (p, truth) in syn.truth() {
-                    let (got, se) = (r.eij[&p], r.std_err[&p]);
+                    let (got, se) = (r.eij[&p].value, r.eij[&p].std_err);
                     let z = (got - truth) / se;
                     assert!(
                         z.abs() < 3.0,
@@ -85,7 +85,7 @@ fn noisy_recovery_within_three_standard_errors() {
                 assert!(r.warnings.is_empty(), "{:?}", r.warnings);
                 let route = r.ellipse_fit.as_ref().unwrap();
                 for (p, v) in &route.eij {
-                    let z = (v - route.predicted_from_joint[p]) / r.std_err[p];
+                    let z = (v - route.predicted_from_joint[p]) / r.eij[p].std_err;
                     z2_ellipse.push(z * z);
                 }
             }
@@ -117,11 +117,11 @@ fn routes_agree_with_theory_noise_free() {
             let syn = Synth::new(plane, true, accel).exact();
             let r = evaluate(&syn.series(), &EvalOptions::default()).unwrap();
             let truth = syn.truth();
-            for (p, v) in &r.plane_fit.eij {
+            for (p, v) in &r.plane_fit.value_map() {
                 assert!(
-                    (v - r.eij[p]).abs() <= 1e-9 * r.eij[p].abs().max(1.0),
+                    (v - r.eij[p].value).abs() <= 1e-9 * r.eij[p].value.abs().max(1.0),
                     "{p}: plane fit {v} vs joint {}",
-                    r.eij[p]
+                    r.eij[p].value
                 );
             }
             let k = 1e-6 * syn.omega0().powi(2);
@@ -137,7 +137,7 @@ fn routes_agree_with_theory_noise_free() {
                 );
                 // The first-order difference from the joint fit is −E_ij ε_ij / 2.
                 let second_order = -e_ij * k * e_ij / 2.0;
-                let diff = got - r.eij[&eij::axes::Eij::new(i, i)];
+                let diff = got - r.eij[&eij::axes::Eij::new(i, i)].value;
                 assert!(
                     (diff - second_order).abs()
                         <= 2.0 * (k * e_ij.abs().max(e_ii.abs())).powi(2) / k,
@@ -160,7 +160,7 @@ fn servo_lag_does_not_leak_into_cross_talk() {
     let r1 = evaluate(&with_lag.series(), &EvalOptions::default()).unwrap();
     let r0 = evaluate(&no_lag.series(), &EvalOptions::default()).unwrap();
     for p in Plane::Zx.parameters() {
-        assert!((r1.eij[&p] - r0.eij[&p]).abs() < 1e-9, "{p}");
+        assert!((r1.eij[&p].value - r0.eij[&p].value).abs() < 1e-9, "{p}");
     }
 }
 
@@ -188,9 +188,9 @@ fn long_dwells_still_give_the_plateau() {
     assert_eq!(r.revolutions, 5);
     for (p, truth) in syn.truth() {
         assert!(
-            (r.eij[&p] - truth).abs() < 1e-9,
+            (r.eij[&p].value - truth).abs() < 1e-9,
             "{p}: {} vs {truth}",
-            r.eij[&p]
+            r.eij[&p].value
         );
     }
 }
@@ -206,12 +206,12 @@ fn noisy_internal_readings_are_tolerated() {
         let r = evaluate(&syn.series(), &EvalOptions::default()).unwrap();
         assert_eq!(r.revolutions, 5);
         for (p, truth) in syn.truth() {
-            let z = (r.eij[&p] - truth) / r.std_err[&p];
+            let z = (r.eij[&p].value - truth) / r.eij[&p].std_err;
             assert!(
                 z.abs() < 3.0,
                 "{plane} {p}: {} ± {}",
-                r.eij[&p],
-                r.std_err[&p]
+                r.eij[&p].value,
+                r.eij[&p].std_err
             );
         }
     }

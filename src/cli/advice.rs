@@ -6,7 +6,7 @@ use eij::ident::IdentError;
 use eij::map::MapError;
 use eij::measured::MeasuredError;
 use eij::predict::PredictError;
-use eij::rtest::RtestError;
+use eij::rtest::{Named, RtestError, Warning};
 
 /// The error's message with its causes, `a: b: c`, as anyhow prints it.
 fn chain(e: impl std::error::Error + Send + Sync + 'static) -> String {
@@ -24,20 +24,20 @@ pub fn evaluate(e: MeasuredError) -> anyhow::Error {
 }
 
 /// A warning of the evaluation with the option that answers it.
-pub fn evaluate_warning(w: &str) -> String {
-    if w.starts_with("no set radius given") {
-        format!("{w}; give --radius-mm")
-    } else {
-        w.to_string()
+pub fn evaluate_warning(w: &Warning) -> String {
+    match w {
+        Warning::NoSetRadius { .. } => format!("{w}; give --radius-mm"),
+        _ => w.to_string(),
     }
 }
 
 /// A warning of the measured data read by `eij identify`, with the option that answers it.
-pub fn identify_warning(w: &str) -> String {
-    if w.contains("no set radius in the test's conditions") {
-        format!("{w}; give --radius-mm or radius_mm in rtest.toml")
-    } else {
-        w.to_string()
+pub fn identify_warning(w: &Named) -> String {
+    match w.warning {
+        Warning::DefaultRadius { .. } => {
+            format!("{w}; give --radius-mm or radius_mm in rtest.toml")
+        }
+        _ => w.to_string(),
     }
 }
 

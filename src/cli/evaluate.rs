@@ -268,9 +268,9 @@ fn render_result(out: &mut String, t: &EvaluatedTest) {
             out,
             "  {:<9} {:>12.4} {:>10.4}  {:>12} {:>12}",
             p.name(),
-            r.eij[&p],
-            r.std_err[&p],
-            route(&r.plane_fit.eij),
+            r.eij[&p].value,
+            r.eij[&p].std_err,
+            route(&r.plane_fit.value_map()),
             r.ellipse_fit
                 .as_ref()
                 .map_or(String::new(), |e| route(&e.eij))
@@ -349,11 +349,11 @@ fn render_pooled(out: &mut String, p: &PooledResult) {
             out,
             "  {:<9} {:>12.4} {:>10.4}  {:<9} {:>12.5} {:>10.5}",
             k.name(),
-            p.eij[&k],
-            p.std_err[&k],
+            p.eij[&k].value,
+            p.eij[&k].std_err,
             rtest::pooled::geometric_name(k),
-            p.geometric_um_per_mm[&k],
-            p.geometric_std_err[&k]
+            p.geometric_um_per_mm[&k].value,
+            p.geometric_um_per_mm[&k].std_err
         );
     }
     let _ = writeln!(out, "  rms residual {:.4} µm", p.rms_residual_um);

@@ -38,8 +38,8 @@ pub fn run(args: EvaluateMoveArgs) -> anyhow::Result<()> {
         "value",
         "std err"
     );
-    for ((e, v), s) in m.eij.iter().zip(m.std_err.values()) {
-        outln!("  {:<5} {:>10.4} {:>10.4}", e.name(), v, s);
+    for (e, v) in &m.eij {
+        outln!("  {:<5} {:>10.4} {:>10.4}", e.name(), v.value, v.std_err);
     }
     Ok(())
 }

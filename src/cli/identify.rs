@@ -171,7 +171,7 @@ struct Prepared {
     problem: Problem,
     provenance: Provenance,
     /// What reading the measured tests found (conditions, clocks), for the report's warnings.
-    warnings: Vec<String>,
+    warnings: Vec<eij::rtest::Named>,
     /// How measured data were read (validation data are read alike).
     measured_options: MeasuredOptions,
     /// The clock offsets the evaluation estimated.
@@ -255,9 +255,7 @@ fn run_identification(prep: &Prepared, quiet: bool) -> anyhow::Result<(IdentResu
     let mut result = result.map_err(super::advice::identify)?;
     result.warnings.splice(
         0..0,
-        prep.warnings
-            .iter()
-            .map(|w| super::advice::identify_warning(w)),
+        prep.warnings.iter().map(super::advice::identify_warning),
     );
     for w in &result.warnings {
         errln!("warning: {w}");

@@ -11,6 +11,7 @@ use eij::ident::validation::Validation;
 use eij::ident::verdict::{format_interval, implausible, Standing};
 use eij::ident::{IdentResult, Problem};
 use eij::rtest::pooled::geometric_name;
+use eij::Estimate;
 
 /// Correlations at least this large in magnitude are listed in the short output.
 const STRONG_CORRELATION: f64 = 0.9;
@@ -169,7 +170,14 @@ fn print_eij_table(p: &Problem, result: &IdentResult) {
         "test"
     );
     for (i, t) in p.tests().iter().enumerate() {
-        for (e, (m, s)) in &t.measured {
+        for (
+            e,
+            &Estimate {
+                value: m,
+                std_err: s,
+            },
+        ) in &t.measured
+        {
             let sim = |v: &eij::ident::EijMap| v.get(e).copied().unwrap_or(f64::NAN);
             let (a, b) = (
                 sim(&result.simulated_initial[i]),
@@ -212,21 +220,29 @@ fn print_groups(p: &Problem, result: &IdentResult) {
         let z: Vec<(f64, String)> = t
             .measured
             .iter()
-            .map(|(e, (m, s))| {
-                let sim = result.simulated_final[i]
-                    .get(e)
-                    .copied()
-                    .unwrap_or(f64::NAN);
-                (
-                    (sim - m) / s,
-                    format!(
-                        "{} {} {} {e}",
-                        t.circle.plane,
-                        t.circle.direction,
-                        short_accel(t)
-                    ),
-                )
-            })
+            .map(
+                |(
+                    e,
+                    &Estimate {
+                        value: m,
+                        std_err: s,
+                    },
+                )| {
+                    let sim = result.simulated_final[i]
+                        .get(e)
+                        .copied()
+                        .unwrap_or(f64::NAN);
+                    (
+                        (sim - m) / s,
+                        format!(
+                            "{} {} {} {e}",
+                            t.circle.plane,
+                            t.circle.direction,
+                            short_accel(t)
+                        ),
+                    )
+                },
+            )
             .collect();
         match groups.iter_mut().find(|g| g.0 == key) {
             Some(g) => {
@@ -269,7 +285,14 @@ fn short_accel(t: &eij::ident::TestCase) -> String {
 fn print_ratios(p: &Problem, result: &IdentResult) {
     let (mut before, mut after) = (Vec::new(), Vec::new());
     for (i, t) in p.tests().iter().enumerate() {
-        for (e, (m, s)) in &t.measured {
+        for (
+            e,
+            &Estimate {
+                value: m,
+                std_err: s,
+            },
+        ) in &t.measured
+        {
             if m.abs() > RATIO_SIGMAS * s {
                 before.push(result.simulated_initial[i][e] / m);
                 after.push(result.simulated_final[i][e] / m);

@@ -19,7 +19,7 @@ use std::path::{Path, PathBuf};
 /// use eij::ident::{Identification, TestCase};
 /// use eij::predict::{simulated_eij, CircleTest, SimSettings};
 /// use eij::machine::Reduction;
-/// use eij::{Direction, Machine, Plane};
+/// use eij::{Direction, EijEstimates, Machine, Plane};
 ///
 /// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/machines/demo-vmc.toml");
 /// let machine = Machine::from_file(std::path::Path::new(path))?;
@@ -34,7 +34,7 @@ use std::path::{Path, PathBuf};
 /// let tests = circles.into_iter().zip(eij).map(|(circle, values)| TestCase {
 ///     source: "synthetic".into(),
 ///     circle,
-///     measured: values.into_iter().map(|(p, v)| (p, (v, 0.02))).collect(),
+///     measured: EijEstimates::with_std_err(values, 0.02),
 ///     clock: None,
 /// });
 ///

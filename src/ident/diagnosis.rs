@@ -318,7 +318,7 @@ impl From<&crate::measured::suite::ClockReport> for ClockOffsetReport {
             std_err_ms: c.std_err_ms,
             separable: c.separable,
             applied: c.applied,
-            notes: c.notes.clone(),
+            notes: c.notes.iter().map(ToString::to_string).collect(),
         }
     }
 }

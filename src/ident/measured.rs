@@ -3,11 +3,13 @@
 
 pub use super::settings::MeasuredOptions;
 use super::{IdentError, TestCase};
-use crate::measured::conditions::Recording;
+use crate::axes::EijEstimates;
+use crate::measured::conditions::DataFiles;
 use crate::measured::inputs::{MeasuredInputs, TestInput};
 use crate::measured::suite::{evaluate_tests, ClockReport, SuiteOptions};
 use crate::measured::table;
 use crate::predict::CircleTest;
+use crate::rtest::{Named, Warning};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
@@ -27,7 +29,7 @@ pub struct Measured {
     pub tests: Vec<TestCase>,
     /// What the evaluation says about conditions and clocks, naming the test or clock; and,
     /// with [`MeasuredOptions::fit_time_offset`], which tests' clock offset is not separable.
-    pub warnings: Vec<String>,
+    pub warnings: Vec<Named>,
     /// The clocks whose offsets the evaluation estimated (applied to single-file tests with
     /// [`MeasuredOptions::fit_time_offset`]; two-system recordings are always aligned).
     pub clocks: Vec<ClockReport>,
@@ -43,7 +45,7 @@ pub fn load_measured(
     let inputs = &inputs.tests;
     let (tables, series): (Vec<&TestInput>, Vec<&TestInput>) = inputs
         .iter()
-        .partition(|t| matches!(&t.recording, Recording::Single(f) if table::looks_like_table(f)));
+        .partition(|t| matches!(&t.data, DataFiles::Single(f) if table::looks_like_table(f)));
     let series: Vec<TestInput> = series.into_iter().cloned().collect();
     let suite = evaluate_tests(
         &series,
@@ -62,21 +64,19 @@ pub fn load_measured(
             .map(|t| t.input.name())
             .collect();
         if !unseparated.is_empty() {
-            warnings.push(format!(
-                "the clock offset between scales and R-Test is not separable from cross-talk for {} test(s) ({}{}): a probe-logger lag there would pass as antisymmetric in-plane cross-talk (separable with cw and ccw at one acceleration, or three circle speeds, per folder)",
-                unseparated.len(),
-                unseparated.iter().take(3).cloned().collect::<Vec<_>>().join(", "),
-                if unseparated.len() > 3 { ", …" } else { "" }
-            ));
+            warnings.push(Named {
+                name: None,
+                warning: Warning::ClockOffsetNotSeparable { tests: unseparated },
+            });
         }
     }
     let clocks = suite.clocks;
-    warnings.extend(
-        suite
-            .tests
-            .iter()
-            .flat_map(|t| t.notes.iter().map(|n| format!("{}: {n}", t.input.name()))),
-    );
+    warnings.extend(suite.tests.iter().flat_map(|t| {
+        t.notes.iter().map(|n| Named {
+            name: Some(t.input.name()),
+            warning: n.clone(),
+        })
+    }));
     let mut evaluated = suite.tests.into_iter();
     let mut tests = Vec::new();
     for input in inputs {
@@ -100,11 +100,7 @@ pub fn load_measured(
                 accel_m_s2: result.accel_m_s2,
                 position_m,
             },
-            measured: result
-                .eij
-                .iter()
-                .map(|(p, v)| (*p, (*v, result.std_err[p])))
-                .collect(),
+            measured: result.eij,
             clock: Some(
                 input
                     .primary_file()
@@ -143,7 +139,7 @@ fn table_of_series(tests: &[TestCase]) -> Option<(String, String)> {
                 && !t.measured.is_empty()
                 && t.measured
                     .iter()
-                    .all(|(p, (v, _))| s.measured.get(p).is_some_and(|(w, _)| same(*v, *w)))
+                    .all(|(p, v)| s.measured.value(p).is_some_and(|w| same(v.value, w)))
         });
         if let Some(s) = repeated {
             return Some((
@@ -186,13 +182,11 @@ fn table_tests(
                 accel_m_s2: row.accel_m_s2,
                 position_m: position_m.clone(),
             },
-            measured: BTreeMap::new(),
+            measured: EijEstimates::new(),
             clock: None,
         });
-        case.measured.insert(
-            row.parameter,
-            (row.value, row.std_err.unwrap_or(opts.table_std_err)),
-        );
+        let std_err = row.std_err.unwrap_or(opts.table_std_err);
+        case.measured.insert(row.parameter, row.value, std_err);
     }
     Ok(groups.into_values().collect())
 }

@@ -8,12 +8,11 @@ use super::parameters::{to_factor, to_theta, Parameter};
 use super::settings::SIMULATION_RESOLUTION;
 use super::statics::{Row, Statics};
 use super::{IdentError, Settings};
-use crate::axes::Eij;
+use crate::axes::EijEstimates;
 use crate::machine::Machine;
 use crate::predict::{CircleTest, EijMap, PredictError, Prediction, SolverKind};
 use argmin::core::{CostFunction, Jacobian, Operator};
 use nalgebra::{DMatrix, DVector};
-use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
@@ -25,7 +24,7 @@ pub struct TestCase {
     /// The conditions it was measured under, simulated alike.
     pub circle: CircleTest,
     /// Measured value and standard uncertainty σ per parameter, µm·s²/m.
-    pub measured: BTreeMap<Eij, (f64, f64)>,
+    pub measured: EijEstimates,
     /// The clock it was recorded on (tests sharing one time offset between scales and R-Test,
     /// e.g. the files of one folder); `None`: its own (a table row group).
     pub clock: Option<String>,
@@ -145,10 +144,10 @@ impl Problem {
             .iter()
             .enumerate()
             .flat_map(|(i, t)| {
-                t.measured.iter().map(move |(eij, (_, sigma))| Row {
+                t.measured.iter().map(move |(eij, m)| Row {
                     test: i,
                     eij: *eij,
-                    sigma: sigma.max(settings.sigma_floor),
+                    sigma: m.std_err.max(settings.sigma_floor),
                     r_over_a: t.circle.radius_mm / t.circle.accel_m_s2,
                     direction: t.circle.direction,
                 })
@@ -379,7 +378,7 @@ impl Problem {
         DVector::from_iterator(
             self.rows.len(),
             self.rows.iter().map(|row| {
-                let value = self.tests[row.test].measured[&row.eij].0;
+                let value = self.tests[row.test].measured[&row.eij].value;
                 let sim = sims[row.test].get(&row.eij).copied().unwrap_or(f64::NAN);
                 (sim - value) / row.sigma
             }),

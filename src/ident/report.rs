@@ -8,7 +8,7 @@ use super::diagnosis::{
 };
 use super::verdict::{Chi2, Standing};
 use super::{IdentResult, Method, Problem, Settings, SolverKind, StaticTerms};
-use crate::axes::{Direction, Eij, Plane};
+use crate::axes::{Direction, Eij, EijMap, Plane};
 use crate::machine::raw::{RawProvenance, RawProvenanceParameter};
 use crate::machine::stiffness::StiffnessRow;
 use serde::{Deserialize, Deserializer, Serialize};
@@ -85,11 +85,8 @@ pub fn utc_timestamp() -> Result<String, SourceDateError> {
     Ok(humantime::format_rfc3339_seconds(time).to_string())
 }
 
-/// EIJ values by parameter, µm·s²/m. A value a simulation lacks is NaN, written as `null`.
-pub type EijValues = BTreeMap<Eij, f64>;
-
-/// `null` read as NaN (serde_json writes NaN as `null`).
-fn nan_values<'de, D: Deserializer<'de>>(d: D) -> Result<EijValues, D::Error> {
+/// `null` read as NaN (serde_json writes NaN as `null`: a value a simulation lacks).
+fn nan_values<'de, D: Deserializer<'de>>(d: D) -> Result<EijMap, D::Error> {
     let m = BTreeMap::<Eij, Option<f64>>::deserialize(d)?;
     Ok(m.into_iter()
         .map(|(k, v)| (k, v.unwrap_or(f64::NAN)))
@@ -97,7 +94,7 @@ fn nan_values<'de, D: Deserializer<'de>>(d: D) -> Result<EijValues, D::Error> {
 }
 
 /// As [`nan_values`], for an optional map.
-fn nan_values_opt<'de, D: Deserializer<'de>>(d: D) -> Result<Option<EijValues>, D::Error> {
+fn nan_values_opt<'de, D: Deserializer<'de>>(d: D) -> Result<Option<EijMap>, D::Error> {
     let m = Option::<BTreeMap<Eij, Option<f64>>>::deserialize(d)?;
     Ok(m.map(|m| {
         m.into_iter()
@@ -344,25 +341,25 @@ pub struct TestReport {
     pub position_mm: Option<Vec<f64>>,
     /// Measured EIJ.
     #[serde(deserialize_with = "nan_values")]
-    pub measured: EijValues,
+    pub measured: EijMap,
     /// Their standard errors (σ of the weighting before the floor).
     #[serde(default, deserialize_with = "nan_values")]
-    pub measured_std_err: EijValues,
+    pub measured_std_err: EijMap,
     /// Simulated with the starting factors.
     #[serde(deserialize_with = "nan_values")]
-    pub simulated_initial: EijValues,
+    pub simulated_initial: EijMap,
     /// Simulated with the identified factors.
     #[serde(deserialize_with = "nan_values")]
-    pub simulated_final: EijValues,
+    pub simulated_final: EijMap,
     /// The same in the time domain (confirmation of a harmonic optimisation).
     #[serde(default, deserialize_with = "nan_values_opt")]
-    pub simulated_final_time_domain: Option<EijValues>,
+    pub simulated_final_time_domain: Option<EijMap>,
     /// simulated_initial / measured (measured values ≠ 0).
     #[serde(default, deserialize_with = "nan_values")]
-    pub ratio_initial: EijValues,
+    pub ratio_initial: EijMap,
     /// simulated_final / measured (measured values ≠ 0).
     #[serde(default, deserialize_with = "nan_values")]
-    pub ratio_final: EijValues,
+    pub ratio_final: EijMap,
 }
 
 /// A report JSON that cannot be read: the key path (`tests[1].simulated_final`) and what is
@@ -384,14 +381,14 @@ impl IdentReport {
             .iter()
             .enumerate()
             .map(|(i, t)| {
-                let measured: EijValues = t.measured.iter().map(|(p, (v, _))| (*p, *v)).collect();
-                let only_measured = |sim: &EijValues| -> EijValues {
+                let measured: EijMap = t.measured.value_map();
+                let only_measured = |sim: &EijMap| -> EijMap {
                     measured
                         .keys()
                         .map(|p| (*p, sim.get(p).copied().unwrap_or(f64::NAN)))
                         .collect()
                 };
-                let ratio = |sim: &EijValues| -> EijValues {
+                let ratio = |sim: &EijMap| -> EijMap {
                     measured
                         .iter()
                         .filter(|(_, m)| m.abs() > 0.0)
@@ -406,7 +403,7 @@ impl IdentReport {
                     accel_m_s2: t.circle.accel_m_s2,
                     freq_hz: Some(t.circle.freq_hz()),
                     position_mm: Some(problem.position_m(i).iter().map(|v| v * 1e3).collect()),
-                    measured_std_err: t.measured.iter().map(|(p, (_, s))| (*p, *s)).collect(),
+                    measured_std_err: t.measured.std_err_map(),
                     simulated_initial: only_measured(&result.simulated_initial[i]),
                     simulated_final: only_measured(&result.simulated_final[i]),
                     simulated_final_time_domain: result

@@ -147,9 +147,10 @@ pub fn epoch_s(date: &str) -> Result<f64, String> {
         .map_err(|_| format!("{date}: before 1970"))
 }
 
-/// What a test's data are: one file with both measurements, or one file per measuring system.
+/// What a test's data are: one file with both measurements, or one file per measuring system
+/// (each read into one system's [`crate::rtest::clock::Recording`]).
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub enum Recording {
+pub enum DataFiles {
     /// One file with `t_s`, the internal and the external columns.
     Single(PathBuf),
     /// Two systems with their own clocks: the internal file (`t_s` and `_int_mm`, e.g. a CNC
@@ -168,7 +169,7 @@ pub struct TestEntry {
     /// 1-based number of the entry in `rtest.toml`.
     pub number: usize,
     /// Its data, paths relative to the folder resolved.
-    pub recording: Recording,
+    pub data: DataFiles,
     /// Circle plane, where stated.
     pub plane: Option<Plane>,
     /// Sense of rotation, where stated (checked against the data).
@@ -255,9 +256,9 @@ impl TestConditions {
         })?;
         let mut c = TestConditions::from_toml_str(&text, &name)?;
         for t in &mut c.tests {
-            t.recording = match &t.recording {
-                Recording::Single(f) => Recording::Single(dir.join(f)),
-                Recording::Split { internal, external } => Recording::Split {
+            t.data = match &t.data {
+                DataFiles::Single(f) => DataFiles::Single(dir.join(f)),
+                DataFiles::Split { internal, external } => DataFiles::Split {
                     internal: dir.join(internal),
                     external: dir.join(external),
                 },
@@ -408,8 +409,8 @@ fn test_entry(
     bad: &dyn Fn(&str, String) -> MeasuredError,
 ) -> Result<TestEntry, MeasuredError> {
     let key = |k: &str| format!("[[test]] #{number} {k}");
-    let recording = match (t.file, t.internal, t.external) {
-        (Some(f), None, None) => Recording::Single(f),
+    let data = match (t.file, t.internal, t.external) {
+        (Some(f), None, None) => DataFiles::Single(f),
         (None, Some(internal), Some(external)) => {
             if internal == external {
                 return Err(bad(
@@ -417,7 +418,7 @@ fn test_entry(
                     "names the same file as internal".into(),
                 ));
             }
-            Recording::Split { internal, external }
+            DataFiles::Split { internal, external }
         }
         (None, Some(_), None) => {
             return Err(bad(
@@ -474,7 +475,7 @@ fn test_entry(
     }
     Ok(TestEntry {
         number,
-        recording,
+        data,
         plane,
         direction,
         radius_mm: t.radius_mm,

@@ -6,7 +6,7 @@ use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
 use super::conditions::{
-    folder_of, DiagnosisSettings, Recording, Session, TestConditions, TestEntry, MAX_TESTS,
+    folder_of, DataFiles, DiagnosisSettings, Session, TestConditions, TestEntry, MAX_TESTS,
 };
 use super::error::MeasuredError;
 use super::layout::ColumnMap;
@@ -19,7 +19,7 @@ use crate::rtest::CircleSeries;
 #[derive(Debug, Clone, PartialEq)]
 pub struct TestInput {
     /// Its data.
-    pub recording: Recording,
+    pub data: DataFiles,
     /// The `rtest.toml` that states its conditions, if any.
     pub conditions_file: Option<PathBuf>,
     /// The number of its `[[test]]` entry, if it has one.
@@ -57,19 +57,19 @@ pub struct TestInput {
 impl TestInput {
     /// The test's name in outputs: its file, or `internal + external`.
     pub fn name(&self) -> String {
-        match &self.recording {
-            Recording::Single(f) => f.display().to_string(),
-            Recording::Split { internal, external } => {
+        match &self.data {
+            DataFiles::Single(f) => f.display().to_string(),
+            DataFiles::Split { internal, external } => {
                 format!("{} + {}", internal.display(), external.display())
             }
         }
     }
 
-    /// Every file the test is read from: its recording(s) and its `rtest.toml`.
+    /// Every file the test is read from: its data file(s) and its `rtest.toml`.
     pub fn files(&self) -> Vec<PathBuf> {
-        let mut v = match &self.recording {
-            Recording::Single(f) => vec![f.clone()],
-            Recording::Split { internal, external } => vec![internal.clone(), external.clone()],
+        let mut v = match &self.data {
+            DataFiles::Single(f) => vec![f.clone()],
+            DataFiles::Split { internal, external } => vec![internal.clone(), external.clone()],
         };
         v.extend(self.conditions_file.clone());
         v
@@ -77,27 +77,27 @@ impl TestInput {
 
     /// The file that orders and labels the test: its file, or its internal file.
     pub fn primary_file(&self) -> &Path {
-        match &self.recording {
-            Recording::Single(f) => f,
-            Recording::Split { internal, .. } => internal,
+        match &self.data {
+            DataFiles::Single(f) => f,
+            DataFiles::Split { internal, .. } => internal,
         }
     }
 
     /// Reads a single-file test (column map applied). Two-system tests are read and brought
     /// onto one time base by [`crate::rtest::clock`].
     pub fn read_single(&self) -> Result<CircleSeries, MeasuredError> {
-        match &self.recording {
-            Recording::Single(f) => CircleSeries::read_csv_with(f, &self.columns),
-            Recording::Split { .. } => Err(MeasuredError::Io {
+        match &self.data {
+            DataFiles::Single(f) => CircleSeries::read_csv_with(f, &self.columns),
+            DataFiles::Split { .. } => Err(MeasuredError::Io {
                 path: self.name(),
                 message: "a test recorded by two systems is read through rtest::clock".into(),
             }),
         }
     }
 
-    fn new(recording: Recording, cond: &TestConditions, folder: &Path) -> TestInput {
+    fn new(data: DataFiles, cond: &TestConditions, folder: &Path) -> TestInput {
         TestInput {
-            recording,
+            data,
             conditions_file: cond.file.clone(),
             entry: None,
             radius_mm: cond.radius_mm,
@@ -118,7 +118,7 @@ impl TestInput {
     }
 
     fn from_entry(e: &TestEntry, cond: &TestConditions, folder: &Path) -> TestInput {
-        let mut t = TestInput::new(e.recording.clone(), cond, folder);
+        let mut t = TestInput::new(e.data.clone(), cond, folder);
         t.entry = Some(e.number);
         t.radius_mm = e.radius_mm.or(cond.radius_mm);
         t.position_mm = e.position_mm.clone().or_else(|| cond.position_mm.clone());
@@ -136,9 +136,9 @@ impl TestInput {
 
 /// The files an entry names, with the key that names them.
 fn entry_files(e: &TestEntry) -> Vec<(&'static str, &Path)> {
-    match &e.recording {
-        Recording::Single(f) => vec![("file", f)],
-        Recording::Split { internal, external } => {
+    match &e.data {
+        DataFiles::Single(f) => vec![("file", f)],
+        DataFiles::Split { internal, external } => {
             vec![("internal", internal), ("external", external)]
         }
     }
@@ -222,7 +222,7 @@ fn folder_tests(dir: &Path, ancestors: &mut Vec<FileId>) -> Result<Vec<TestInput
         {
             items.push((
                 p.clone(),
-                vec![TestInput::new(Recording::Single(p), &cond, dir)],
+                vec![TestInput::new(DataFiles::Single(p), &cond, dir)],
             ));
         }
         if items.len() > MAX_TESTS {
@@ -259,14 +259,14 @@ fn file_test(file: &Path) -> Result<TestInput, MeasuredError> {
                 ..cond.clone()
             })?;
             let mut t = TestInput::from_entry(e, &cond, &dir);
-            if let Recording::Single(_) = t.recording {
-                t.recording = Recording::Single(file.to_path_buf());
+            if let DataFiles::Single(_) = t.data {
+                t.data = DataFiles::Single(file.to_path_buf());
             }
             return Ok(t);
         }
     }
     Ok(TestInput::new(
-        Recording::Single(file.to_path_buf()),
+        DataFiles::Single(file.to_path_buf()),
         &cond,
         &dir,
     ))
@@ -292,8 +292,8 @@ pub fn expand_tests(paths: &[PathBuf]) -> Result<Vec<TestInput>, MeasuredError> 
         } else if std::fs::metadata(p).is_ok() {
             // A file, or a pipe or device read like one (within the size limit).
             let t = file_test(p)?;
-            let twice = matches!(t.recording, Recording::Split { .. })
-                && tests.iter().any(|o| o.recording == t.recording);
+            let twice =
+                matches!(t.data, DataFiles::Split { .. }) && tests.iter().any(|o| o.data == t.data);
             if !twice {
                 tests.push(t);
             }
@@ -354,9 +354,9 @@ fn once_each(tests: &[TestInput]) -> Result<(), MeasuredError> {
     refuse_copies(tests)?;
     let mut seen: Vec<(FileId, &Path)> = Vec::new();
     for t in tests {
-        let files: Vec<&Path> = match &t.recording {
-            Recording::Single(f) => vec![f],
-            Recording::Split { internal, external } => vec![internal, external],
+        let files: Vec<&Path> = match &t.data {
+            DataFiles::Single(f) => vec![f],
+            DataFiles::Split { internal, external } => vec![internal, external],
         };
         for f in files {
             let Some(id) = FileId::of(f) else { continue };
@@ -379,9 +379,9 @@ fn once_each(tests: &[TestInput]) -> Result<(), MeasuredError> {
 fn refuse_copies(tests: &[TestInput]) -> Result<(), MeasuredError> {
     let mut sized: Vec<(u64, &Path)> = Vec::new();
     for t in tests {
-        let files: Vec<&Path> = match &t.recording {
-            Recording::Single(f) => vec![f],
-            Recording::Split { internal, external } => vec![internal, external],
+        let files: Vec<&Path> = match &t.data {
+            DataFiles::Single(f) => vec![f],
+            DataFiles::Split { internal, external } => vec![internal, external],
         };
         for f in files {
             let Ok(m) = std::fs::metadata(f) else {
@@ -430,9 +430,9 @@ impl MeasuredInputs {
     pub fn data_files(&self) -> Vec<PathBuf> {
         self.tests
             .iter()
-            .flat_map(|t| match &t.recording {
-                Recording::Single(f) => vec![f.clone()],
-                Recording::Split { internal, external } => vec![internal.clone(), external.clone()],
+            .flat_map(|t| match &t.data {
+                DataFiles::Single(f) => vec![f.clone()],
+                DataFiles::Split { internal, external } => vec![internal.clone(), external.clone()],
             })
             .collect()
     }

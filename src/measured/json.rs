@@ -3,7 +3,7 @@
 //! `direction`, `radius_mm`, `accel_m_s2`, `freq_hz`, `eij_um_s2_per_m`, `std_err_um_s2_per_m`,
 //! `rms_residual_um`) and eij's own additions documented in docs/measurement-files.md.
 
-use crate::axes::Eij;
+use crate::axes::EijMap;
 use crate::rtest::iso230::{CircleFigures, PathFigures};
 use crate::rtest::CircleResult;
 use serde::{Deserialize, Serialize};
@@ -13,7 +13,7 @@ use std::collections::BTreeMap;
 /// EIJ (or their standard errors) keyed by name (`EZZ`, …), µm·s²/m.
 pub type EijByName = BTreeMap<String, f64>;
 
-fn by_name(map: &BTreeMap<Eij, f64>) -> EijByName {
+fn by_name(map: &EijMap) -> EijByName {
     map.iter().map(|(k, v)| (k.name(), *v)).collect()
 }
 
@@ -101,8 +101,8 @@ impl From<&CircleResult> for CircleJson {
             radius_mm: r.radius_mm,
             accel_m_s2: r.accel_m_s2,
             freq_hz: r.freq_hz,
-            eij_um_s2_per_m: by_name(&r.eij),
-            std_err_um_s2_per_m: by_name(&r.std_err),
+            eij_um_s2_per_m: by_name(&r.eij.value_map()),
+            std_err_um_s2_per_m: by_name(&r.eij.std_err_map()),
             rms_residual_um: r.rms_residual_um,
             measured_radius_mm: r.measured_radius_mm,
             offsets_um: r
@@ -113,8 +113,8 @@ impl From<&CircleResult> for CircleJson {
             revolutions: r.revolutions,
             samples_used: r.samples_used,
             plane_fit: PlaneFitJson {
-                eij_um_s2_per_m: by_name(&r.plane_fit.eij),
-                std_err_um_s2_per_m: by_name(&r.plane_fit.std_err),
+                eij_um_s2_per_m: by_name(&r.plane_fit.value_map()),
+                std_err_um_s2_per_m: by_name(&r.plane_fit.std_err_map()),
             },
             ellipse_fit: r.ellipse_fit.as_ref().map(|e| EllipseJson {
                 eij_um_s2_per_m: by_name(&e.eij),
@@ -127,7 +127,7 @@ impl From<&CircleResult> for CircleJson {
                 external: path(&iso.external),
             }),
             iso230_4: r.iso230,
-            warnings: r.warnings.clone(),
+            warnings: r.warnings.iter().map(ToString::to_string).collect(),
         }
     }
 }

@@ -83,8 +83,8 @@ pub fn rows_from_result(result: &CircleResult) -> Vec<EijRow> {
             direction: result.direction,
             accel_m_s2: result.accel_m_s2,
             parameter: *p,
-            value: result.eij[p],
-            std_err: result.std_err.get(p).copied(),
+            value: result.eij[p].value,
+            std_err: result.eij.std_err(p),
         })
         .collect()
 }

@@ -187,7 +187,7 @@ impl CircleView {
         for e in [ij(a, a), ij(b, b), ij(b, a), ij(a, b)] {
             notes.push(format!(
                 "  {} = {:.4} ± {:.4}",
-                e, self.joint.eij[&e], self.joint.std_err[&e]
+                e, self.joint.eij[&e].value, self.joint.eij[&e].std_err
             ));
         }
         notes.push(format!(
@@ -255,7 +255,7 @@ impl CircleView {
             .map(|i| (phase_deg(i), dk[i]))
             .collect();
         let (e_ka, e_kb) = (Eij::new(k, a), Eij::new(k, b));
-        let (eka, ekb) = (self.joint.eij[&e_ka], self.joint.eij[&e_kb]);
+        let (eka, ekb) = (self.joint.eij[&e_ka].value, self.joint.eij[&e_kb].value);
         let c_k_um = self.joint.offsets_um[&k];
         let acc = self.accel_m_s2();
         let plane = (0..=360)
@@ -285,8 +285,8 @@ impl CircleView {
             ..
         } = self.out_of_plane(MAX_SCATTER_POINTS);
         let (eka, ekb) = (
-            self.joint.eij[&Eij::new(k, a)],
-            self.joint.eij[&Eij::new(k, b)],
+            self.joint.eij[&Eij::new(k, a)].value,
+            self.joint.eij[&Eij::new(k, b)].value,
         );
         let (lo, hi) = svg::padded_range(points.iter().chain(&plane).map(|p| p.1), 0.08);
         let title = format!(
@@ -304,7 +304,7 @@ impl CircleView {
             ),
             Entry::new("fitted plane (joint fit)", svg::FIT, Mark::Line),
         ];
-        let se = |e: Eij| format!("{:.4}", self.joint.std_err[&e]);
+        let se = |e: Eij| format!("{:.4}", self.joint.eij[&e].std_err);
         let notes = vec![
             format!("φ = atan2({b}_int − {b}c, {a}_int − {a}c)"),
             format!("ä{a} = −rω²·cos φ,  ä{b} = −rω²·sin φ"),

@@ -377,9 +377,13 @@ fn verdict_section(page: &mut Page, idents: &[LoadedIdent], suite: &Suite) {
     let tests: Vec<(String, Vec<String>)> = suite
         .tests
         .iter()
-        .map(|t| (test_name(t), t.result.warnings.clone()))
+        .map(|t| {
+            let warnings = t.result.warnings.iter().map(ToString::to_string);
+            (test_name(t), warnings.collect())
+        })
         .collect();
-    h.push_str(&verdict::circle_warnings_html(&tests, &suite.warnings));
+    let set: Vec<String> = suite.warnings.iter().map(ToString::to_string).collect();
+    h.push_str(&verdict::circle_warnings_html(&tests, &set));
     page.push(&h);
 }
 
@@ -451,8 +455,7 @@ fn move_vs_circle_html(
         for (e, v) in &m.eij {
             let vals: Vec<f64> = circles
                 .iter()
-                .filter_map(|c| c.result.eij.get(e))
-                .copied()
+                .filter_map(|c| c.result.eij.value(e))
                 .collect();
             let circle = if vals.is_empty() {
                 "–".to_string()
@@ -468,8 +471,8 @@ fn move_vs_circle_html(
                 "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
                 escape(&path.display().to_string()),
                 e.name(),
-                fmt_eij(*v),
-                fmt_eij(m.std_err[e]),
+                fmt_eij(v.value),
+                fmt_eij(v.std_err),
                 circle
             );
         }
@@ -514,8 +517,8 @@ fn circle_tables(h: &mut String, circles: &[EvaluatedTest]) {
                 let _ = write!(
                     h,
                     "<td>{} ± {}</td>",
-                    fmt_eij(r.eij[&p]),
-                    fmt_eij(r.std_err[&p])
+                    fmt_eij(r.eij[&p].value),
+                    fmt_eij(r.eij[&p].std_err)
                 );
             }
             let _ = writeln!(h, "<td>{:.3}</td></tr>", r.rms_residual_um);

@@ -355,7 +355,10 @@ pub fn out_of_plane_svg(
         let view = super::CircleView::new(&t.series, &opts)?;
         k_axis = view.norm.plane.normal().to_string();
         let oop = view.out_of_plane(MAX_SCATTER);
-        let (eka, ekb) = (view.joint.eij[&oop.e_ka], view.joint.eij[&oop.e_kb]);
+        let (eka, ekb) = (
+            view.joint.eij[&oop.e_ka].value,
+            view.joint.eij[&oop.e_kb].value,
+        );
         let (points, plane) = (oop.points, oop.plane);
         series.push(Series {
             points,

@@ -27,7 +27,7 @@ use nalgebra::{DMatrix, Matrix2};
 use super::fit::joint_lstsq;
 use super::lstsq::lstsq;
 use super::normalise::Normalised;
-use crate::axes::{Eij, Plane};
+use crate::axes::{Eij, EijMap, Plane};
 
 /// Signed angular speeds closer than this ratio count as one.
 const SAME_OMEGA_RATIO: f64 = 1.05;
@@ -60,7 +60,7 @@ pub struct OffsetFit {
     /// beyond their noise, e.g. EIJ that depend on the direction).
     pub chi2_per_dof: f64,
     /// Pooled EIJ per group (corrected for δ), µm·s²/m.
-    pub eij: BTreeMap<String, BTreeMap<Eij, f64>>,
+    pub eij: BTreeMap<String, EijMap>,
 }
 
 struct PerTest {

@@ -7,15 +7,13 @@ use nalgebra::{DMatrix, Matrix2, Vector2};
 
 use super::lstsq::{lstsq, Lstsq};
 use super::normalise::Normalised;
-use crate::axes::{Axis, Eij};
+use crate::axes::{Axis, Eij, EijEstimates, EijMap};
 
 /// Result of the joint fit of one circle test.
 #[derive(Debug, Clone, PartialEq)]
 pub struct JointFit {
-    /// The six EIJ of the plane, µm·s²/m.
-    pub eij: BTreeMap<Eij, f64>,
-    /// Their standard errors, µm·s²/m.
-    pub std_err: BTreeMap<Eij, f64>,
+    /// The six EIJ of the plane with their standard errors, µm·s²/m.
+    pub eij: EijEstimates,
     /// Constant deviations c_i, µm.
     pub offsets_um: BTreeMap<Axis, f64>,
     /// Residual RMS over the three components, µm.
@@ -31,20 +29,18 @@ pub fn joint(norm: &Normalised) -> Option<JointFit> {
     let fit = joint_lstsq(norm)?;
     let (a, b) = norm.plane.axes();
     let components = [a, b, norm.plane.normal()];
-    let mut eij = BTreeMap::new();
-    let mut std_err = BTreeMap::new();
+    let mut eij = EijEstimates::new();
     let mut offsets_um = BTreeMap::new();
     for (col, &dev) in components.iter().enumerate() {
         for (row, acc) in [a, b].into_iter().enumerate() {
-            eij.insert(Eij::new(dev, acc), fit.coef[(row, col)]);
-            std_err.insert(Eij::new(dev, acc), fit.std_err(row, col));
+            let value = fit.coef[(row, col)];
+            eij.insert(Eij::new(dev, acc), value, fit.std_err(row, col));
         }
         offsets_um.insert(dev, fit.coef[(2, col)]);
     }
     let rms_residual_um = (fit.rss.iter().sum::<f64>() / (3 * n) as f64).sqrt();
     Some(JointFit {
         eij,
-        std_err,
         offsets_um,
         rms_residual_um,
     })
@@ -71,7 +67,7 @@ pub fn joint_lstsq(norm: &Normalised) -> Option<Lstsq> {
 /// With φ and ω shared, [ä_a, ä_b] = −ω² [a_set, b_set] holds sample by sample, so this is the
 /// joint fit's normal row in a rescaled regressor: the two agree to rounding (theory: exactly).
 /// It is kept as the paper's route and as a check of the sign and scale of ä.
-pub fn plane_route(norm: &Normalised) -> Option<(BTreeMap<Eij, f64>, BTreeMap<Eij, f64>)> {
+pub fn plane_route(norm: &Normalised) -> Option<EijEstimates> {
     let n = norm.samples();
     let [sa, sb] = &norm.set_mm;
     let x = DMatrix::from_fn(n, 3, |i, j| match j {
@@ -84,13 +80,12 @@ pub fn plane_route(norm: &Normalised) -> Option<(BTreeMap<Eij, f64>, BTreeMap<Ei
     let w2 = norm.omega_rad_s * norm.omega_rad_s;
     let (a, b) = norm.plane.axes();
     let k = norm.plane.normal();
-    let mut eij = BTreeMap::new();
-    let mut se = BTreeMap::new();
+    let mut eij = EijEstimates::new();
     for (row, acc) in [a, b].into_iter().enumerate() {
-        eij.insert(Eij::new(k, acc), -fit.coef[(row, 0)] / w2);
-        se.insert(Eij::new(k, acc), fit.std_err(row, 0) / w2);
+        let (value, se) = (-fit.coef[(row, 0)] / w2, fit.std_err(row, 0) / w2);
+        eij.insert(Eij::new(k, acc), value, se);
     }
-    Some((eij, se))
+    Some(eij)
 }
 
 /// An ellipse x ᵀQ' x = 1 about its centre, in coordinates centred on the internal path's
@@ -155,14 +150,14 @@ pub fn fit_ellipse(a: &[f64], b: &[f64], centre_mm: [f64; 2], radius_mm: f64) ->
 #[derive(Debug, Clone, PartialEq)]
 pub struct EllipseRoute {
     /// E_aa, E_bb by this route, µm·s²/m.
-    pub eij: BTreeMap<Eij, f64>,
+    pub eij: EijMap,
     /// Half-widths (a, b) of the internal path, mm.
     pub half_width_int_mm: [f64; 2],
     /// Half-widths (a, b) of the external path, mm.
     pub half_width_ext_mm: [f64; 2],
     /// The same route applied to the joint fit's noise-free model of the external path
     /// (internal readings + in-plane E·ä), see [`predict_ellipse_route`]; empty until filled.
-    pub predicted_from_joint: BTreeMap<Eij, f64>,
+    pub predicted_from_joint: EijMap,
 }
 
 /// Fits both ellipses over the steady revolutions and converts them to in-talk.
@@ -196,10 +191,10 @@ pub fn ellipse_route(
 pub fn predict_ellipse_route(
     norm: &Normalised,
     int_mm: [&[f64]; 2],
-    eij: &BTreeMap<Eij, f64>,
-) -> Option<BTreeMap<Eij, f64>> {
+    eij: &EijEstimates,
+) -> Option<EijMap> {
     let (a, b) = norm.plane.axes();
-    let e = |i: Axis, j: Axis| eij.get(&Eij::new(i, j)).copied();
+    let e = |i: Axis, j: Axis| eij.value(&Eij::new(i, j));
     let (eaa, eab, eba, ebb) = (e(a, a)?, e(a, b)?, e(b, a)?, e(b, b)?);
     let [acc_a, acc_b] = &norm.acc_m_s2;
     let model = |k: usize, ea: f64, eb: f64| -> Vec<f64> {

@@ -28,7 +28,7 @@
 //! `tests/sim_harmonic.rs` checks that both agree to 1e-9.
 
 use super::error::{Location, RtestError};
-use crate::axes::{Eij, Plane};
+use crate::axes::{Eij, EijMap, Plane};
 use faer::c64;
 use std::collections::BTreeMap;
 use std::f64::consts::TAU;
@@ -83,7 +83,7 @@ pub fn joint_eij(
     radius_mm: f64,
     window: &Window,
     source: &str,
-) -> Result<BTreeMap<Eij, f64>, RtestError> {
+) -> Result<EijMap, RtestError> {
     let whole = || Location::source(source);
     let [ia, ib] = steady.int_mm;
     if ia.norm() < 1e-3 || ib.norm() < 1e-3 {

@@ -34,7 +34,7 @@ use std::collections::BTreeMap;
 
 use serde_json::{json, Value};
 
-use crate::axes::{Axis, Direction, Eij, Plane};
+use crate::axes::{Axis, Direction, Eij, EijEstimates, EijMap, Plane};
 
 pub mod checks;
 pub mod clock;
@@ -49,10 +49,12 @@ pub mod moves;
 pub mod normalise;
 pub mod pooled;
 pub mod series;
+pub mod warning;
 
 pub use error::{Line, Location, RtestError};
 pub use pooled::{evaluate_pooled, PooledResult};
 pub use series::CircleSeries;
+pub use warning::{Named, Warning};
 
 /// Options of [`evaluate`]; `None` means "infer from the data".
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -64,15 +66,6 @@ pub struct EvalOptions {
     /// scale with r, and the mean internal radius differs from the set radius by the axes'
     /// radius errors (e.g. +0.5 µm on 2 mm biases every EIJ by 2.5·10⁻⁴ relative).
     pub radius_mm: Option<f64>,
-}
-
-/// The paper's plane-fit route to the cross-talk E_ka, E_kb (see [`fit::plane_route`]).
-#[derive(Debug, Clone, PartialEq)]
-pub struct PlaneFit {
-    /// E_ka, E_kb, µm·s²/m.
-    pub eij: BTreeMap<Eij, f64>,
-    /// Their standard errors, µm·s²/m.
-    pub std_err: BTreeMap<Eij, f64>,
 }
 
 /// The evaluation of one circle test.
@@ -92,10 +85,9 @@ pub struct CircleResult {
     pub accel_m_s2: f64,
     /// |ω| / 2π, Hz.
     pub freq_hz: f64,
-    /// The six EIJ of the plane from the joint fit, µm·s²/m (primary result).
-    pub eij: BTreeMap<Eij, f64>,
-    /// Their standard errors, µm·s²/m.
-    pub std_err: BTreeMap<Eij, f64>,
+    /// The six EIJ of the plane from the joint fit with their standard errors, µm·s²/m
+    /// (primary result).
+    pub eij: EijEstimates,
     /// Constant deviations per axis, µm.
     pub offsets_um: BTreeMap<Axis, f64>,
     /// Residual RMS of the joint fit over its three components, µm.
@@ -104,8 +96,8 @@ pub struct CircleResult {
     pub revolutions: usize,
     /// Samples used.
     pub samples_used: usize,
-    /// Cross-talk by the paper's plane fit.
-    pub plane_fit: PlaneFit,
+    /// Cross-talk E_ka, E_kb by the paper's plane fit ([`fit::plane_route`]), µm·s²/m.
+    pub plane_fit: EijEstimates,
     /// In-talk by the paper's ellipse fit; `None` (with a warning) when a path is no ellipse.
     pub ellipse_fit: Option<fit::EllipseRoute>,
     /// ISO 230-4 circular and radial deviations of the internal and the external path over the
@@ -113,8 +105,9 @@ pub struct CircleResult {
     pub iso230: Option<iso230::CircleFigures>,
     /// The steady whole revolutions as sample indices of the series.
     pub steady: std::ops::Range<usize>,
-    /// Disagreements between the routes beyond noise (see [`evaluate`]).
-    pub warnings: Vec<String>,
+    /// Disagreements between the routes beyond noise (see [`evaluate`]); a suite of measured
+    /// tests adds what their conditions say ([`crate::measured::suite`]).
+    pub warnings: Vec<Warning>,
 }
 
 /// The fast path for repeated use (e.g. inside identification): normalisation and the joint
@@ -148,7 +141,7 @@ pub const RESOLUTION_UM_S2_PER_M: f64 = 1e-3;
 /// the route's own truncation then cancels and what remains is noise or a model misfit.
 pub fn evaluate(series: &CircleSeries, opts: &EvalOptions) -> Result<CircleResult, RtestError> {
     let (norm, joint) = evaluate_joint(series, opts)?;
-    let (pf_eij, pf_se) = fit::plane_route(&norm).ok_or_else(|| RtestError::Singular {
+    let plane_fit = fit::plane_route(&norm).ok_or_else(|| RtestError::Singular {
         at: Location::source(series.source()),
         detail: "the plane fit has no unique solution".into(),
     })?;
@@ -162,26 +155,29 @@ pub fn evaluate(series: &CircleSeries, opts: &EvalOptions) -> Result<CircleResul
     });
 
     let tolerance =
-        |p: &Eij| 3.0 * std::f64::consts::SQRT_2 * joint.std_err[p] + RESOLUTION_UM_S2_PER_M;
+        |p: &Eij| 3.0 * std::f64::consts::SQRT_2 * joint.eij[p].std_err + RESOLUTION_UM_S2_PER_M;
     let mut warnings = Vec::new();
-    for (p, v) in &pf_eij {
-        let (j, s) = (joint.eij[p], joint.std_err[p]);
-        if (v - j).abs() > tolerance(p) {
-            warnings.push(format!(
-                "plane fit {p} = {v:.4} differs from the joint fit {j:.4} ± {s:.4} µm·s²/m"
-            ));
+    for (p, route) in &plane_fit {
+        if (route.value - joint.eij[p].value).abs() > tolerance(p) {
+            warnings.push(Warning::PlaneFitDiffers {
+                eij: *p,
+                plane_fit: route.value,
+                joint: joint.eij[p],
+            });
         }
     }
     match &ellipse {
-        None => warnings.push("ellipse fit failed: a path is not an ellipse".into()),
+        None => warnings.push(Warning::EllipseFitFailed),
         Some(route) => {
             for (p, v) in &route.eij {
-                let (j, s) = (route.predicted_from_joint[p], joint.std_err[p]);
-                if (v - j).abs() > tolerance(p) {
-                    warnings.push(format!(
-                        "ellipse fit {p} = {v:.4} differs from {j:.4} ± {s:.4} µm·s²/m expected \
-                         from the joint fit"
-                    ));
+                let expected = route.predicted_from_joint[p];
+                if (v - expected).abs() > tolerance(p) {
+                    warnings.push(Warning::EllipseFitDiffers {
+                        eij: *p,
+                        ellipse_fit: *v,
+                        expected,
+                        std_err: joint.eij[p].std_err,
+                    });
                 }
             }
         }
@@ -207,15 +203,11 @@ pub fn evaluate(series: &CircleSeries, opts: &EvalOptions) -> Result<CircleResul
         accel_m_s2: norm.accel_m_s2(),
         freq_hz: norm.freq_hz(),
         eij: joint.eij,
-        std_err: joint.std_err,
         offsets_um: joint.offsets_um,
         rms_residual_um: joint.rms_residual_um,
         revolutions: norm.revolutions,
         samples_used: norm.samples(),
-        plane_fit: PlaneFit {
-            eij: pf_eij,
-            std_err: pf_se,
-        },
+        plane_fit,
         ellipse_fit: ellipse,
         iso230: iso,
         steady: norm.first..norm.end,
@@ -224,6 +216,6 @@ pub fn evaluate(series: &CircleSeries, opts: &EvalOptions) -> Result<CircleResul
 }
 
 /// A parameter map as a JSON object keyed by the parameter names (`EZZ`, ...).
-pub fn eij_json(map: &BTreeMap<Eij, f64>) -> Value {
+pub fn eij_json(map: &EijMap) -> Value {
     Value::Object(map.iter().map(|(k, v)| (k.name(), json!(v))).collect())
 }

@@ -12,9 +12,8 @@
 //! that band (see docs/compensation.md).
 
 use super::lstsq::lstsq;
-use crate::axes::{Axis, Eij};
+use crate::axes::{Axis, Eij, EijEstimates, EijMap};
 use nalgebra::DMatrix;
-use std::collections::BTreeMap;
 
 /// A move file that cannot be evaluated: file, where, what.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -35,10 +34,8 @@ pub struct MoveEij {
     pub source: String,
     /// The moved axis J.
     pub axis: Axis,
-    /// E_XJ, E_YJ, E_ZJ, µm·s²/m.
-    pub eij: BTreeMap<Eij, f64>,
-    /// Their standard errors (white-noise residuals assumed), µm·s²/m.
-    pub std_err: BTreeMap<Eij, f64>,
+    /// E_XJ, E_YJ, E_ZJ with their standard errors (white-noise residuals assumed), µm·s²/m.
+    pub eij: EijEstimates,
     /// Residual RMS per direction x, y, z, µm.
     pub rms_residual_um: [f64; 3],
     /// Largest |set acceleration|, m/s².
@@ -92,20 +89,16 @@ pub fn evaluate_record(rec: &MoveRecord, source: String, axis: Axis) -> Result<M
                 .into(),
         )
     })?;
-    let mut eij = BTreeMap::new();
-    let mut std_err = BTreeMap::new();
+    let mut eij = EijEstimates::new();
     let mut rms = [0.0; 3];
     for (k, dev) in Axis::ALL.into_iter().enumerate() {
-        let e = Eij::new(dev, axis);
-        eij.insert(e, fit.coef[(0, k)]);
-        std_err.insert(e, fit.std_err(0, k));
+        eij.insert(Eij::new(dev, axis), fit.coef[(0, k)], fit.std_err(0, k));
         rms[k] = (fit.rss[k] / n as f64).sqrt();
     }
     Ok(MoveEij {
         source,
         axis,
         eij,
-        std_err,
         rms_residual_um: rms,
         peak_accel_m_s2: peak,
         samples: n,
@@ -116,14 +109,14 @@ impl MoveEij {
     /// The CONTRACT.md JSON: `axis`, `eij_um_s2_per_m`, `std_err_um_s2_per_m`, plus `file`,
     /// `rms_residual_um` (x, y, z), `peak_accel_m_s2` and `samples`.
     pub fn to_json(&self) -> serde_json::Value {
-        let names = |m: &BTreeMap<Eij, f64>| -> serde_json::Map<String, serde_json::Value> {
+        let names = |m: &EijMap| -> serde_json::Map<String, serde_json::Value> {
             m.iter().map(|(k, v)| (k.name(), (*v).into())).collect()
         };
         serde_json::json!({
             "file": self.source,
             "axis": self.axis.name(),
-            "eij_um_s2_per_m": names(&self.eij),
-            "std_err_um_s2_per_m": names(&self.std_err),
+            "eij_um_s2_per_m": names(&self.eij.value_map()),
+            "std_err_um_s2_per_m": names(&self.eij.std_err_map()),
             "rms_residual_um": self.rms_residual_um,
             "peak_accel_m_s2": self.peak_accel_m_s2,
             "samples": self.samples,

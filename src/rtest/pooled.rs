@@ -8,8 +8,8 @@ use nalgebra::DMatrix;
 use super::error::{Location, RtestError};
 use super::lstsq::{lstsq, Lstsq};
 use super::normalise::{normalise, Normalised};
-use super::{CircleSeries, EvalOptions};
-use crate::axes::{Axis, Direction, Eij, Plane};
+use super::{CircleSeries, EvalOptions, Warning};
+use crate::axes::{Axis, Direction, Eij, EijEstimates, EijMap, Plane};
 
 /// Accelerations closer than this ratio count as one.
 const SAME_ACCEL_RATIO: f64 = 1.05;
@@ -25,24 +25,20 @@ pub struct PooledResult {
     pub accel_m_s2: Vec<f64>,
     /// Their directions.
     pub directions: Vec<Direction>,
-    /// The six EIJ of the plane, µm·s²/m.
-    pub eij: BTreeMap<Eij, f64>,
-    /// Their standard errors, µm·s²/m.
-    pub std_err: BTreeMap<Eij, f64>,
-    /// Static geometric terms G_ij, µm per mm of set position of axis j, keyed like EIJ
-    /// (deviation i, in-plane axis j).
-    pub geometric_um_per_mm: BTreeMap<Eij, f64>,
-    /// Their standard errors, µm/mm.
-    pub geometric_std_err: BTreeMap<Eij, f64>,
+    /// The six EIJ of the plane with their standard errors, µm·s²/m.
+    pub eij: EijEstimates,
+    /// Static geometric terms G_ij with their standard errors, µm per mm of set position of
+    /// axis j, keyed like EIJ (deviation i, in-plane axis j).
+    pub geometric_um_per_mm: EijEstimates,
     /// Constant deviations per test and axis, µm.
     pub offsets_um: Vec<BTreeMap<Axis, f64>>,
     /// Residual RMS over all tests and the three components, µm.
     pub rms_residual_um: f64,
     /// (E_cw − E_ccw) / √(se_cw² + se_ccw²) per parameter, when each direction holds tests at
     /// two or more accelerations; empty otherwise.
-    pub cw_ccw_difference_sigma: BTreeMap<Eij, f64>,
+    pub cw_ccw_difference_sigma: EijMap,
     /// Inconsistencies worth a look (cw/ccw beyond 3 combined standard errors, ...).
-    pub warnings: Vec<String>,
+    pub warnings: Vec<Warning>,
 }
 
 /// Pooled fit over several circle tests of one plane, per axis i = a, b, k:
@@ -99,15 +95,7 @@ pub fn evaluate_pooled(
         at: all(),
         detail: "the pooled fit has no unique solution".into(),
     })?;
-    let (mut eij, mut std_err, mut geometric, mut geometric_se) = Default::default();
-    unpack(
-        plane,
-        &fit,
-        &mut eij,
-        &mut std_err,
-        &mut geometric,
-        &mut geometric_se,
-    );
+    let (eij, geometric) = unpack(plane, &fit);
     let (a, b) = plane.axes();
     let comps = [a, b, plane.normal()];
     let offsets_um = (0..norms.len())
@@ -137,34 +125,29 @@ pub fn evaluate_pooled(
     };
     let (cw, ccw) = (subset(Direction::Cw), subset(Direction::Ccw));
     if !cw.is_empty() && !ccw.is_empty() {
-        let per_dir = |set: &[&Normalised]| -> Option<(BTreeMap<Eij, f64>, BTreeMap<Eij, f64>)> {
+        let per_dir = |set: &[&Normalised]| -> Option<EijEstimates> {
             if set.len() < 2 || !separable(set) {
                 return None;
             }
-            let fit = fit_pool(set)?;
-            let (mut e, mut s, mut g, mut gs) = Default::default();
-            unpack(plane, &fit, &mut e, &mut s, &mut g, &mut gs);
-            Some((e, s))
+            Some(unpack(plane, &fit_pool(set)?).0)
         };
         match (per_dir(&cw), per_dir(&ccw)) {
-            (Some((e_cw, s_cw)), Some((e_ccw, s_ccw))) => {
+            (Some(e_cw), Some(e_ccw)) => {
                 for p in plane.parameters() {
-                    let z = (e_cw[&p] - e_ccw[&p]) / s_cw[&p].hypot(s_ccw[&p]);
+                    let (c, cc) = (e_cw[&p], e_ccw[&p]);
+                    let z = (c.value - cc.value) / c.std_err.hypot(cc.std_err);
                     if z.abs() > 3.0 {
-                        warnings.push(format!(
-                            "{p}: cw {:.4} and ccw {:.4} µm·s²/m differ by {z:.1} combined \
-                             standard errors",
-                            e_cw[&p], e_ccw[&p]
-                        ));
+                        warnings.push(Warning::CwCcwDiffer {
+                            eij: p,
+                            cw: c.value,
+                            ccw: cc.value,
+                            z,
+                        });
                     }
                     cw_ccw.insert(p, z);
                 }
             }
-            _ => warnings.push(
-                "cw/ccw consistency not checked: each direction needs tests at two or more \
-                 accelerations"
-                    .into(),
-            ),
+            _ => warnings.push(Warning::CwCcwNotChecked),
         }
     }
     Ok(PooledResult {
@@ -173,9 +156,7 @@ pub fn evaluate_pooled(
         accel_m_s2: norms.iter().map(Normalised::accel_m_s2).collect(),
         directions,
         eij,
-        std_err,
         geometric_um_per_mm: geometric,
-        geometric_std_err: geometric_se,
         offsets_um,
         rms_residual_um,
         cw_ccw_difference_sigma: cw_ccw,
@@ -224,24 +205,18 @@ fn fit_pool(set: &[&Normalised]) -> Option<Lstsq> {
     lstsq(x, y)
 }
 
-fn unpack(
-    plane: Plane,
-    fit: &Lstsq,
-    eij: &mut BTreeMap<Eij, f64>,
-    std_err: &mut BTreeMap<Eij, f64>,
-    geometric: &mut BTreeMap<Eij, f64>,
-    geometric_se: &mut BTreeMap<Eij, f64>,
-) {
+/// The EIJ and the geometric terms of a pooled fit, with their standard errors.
+fn unpack(plane: Plane, fit: &Lstsq) -> (EijEstimates, EijEstimates) {
+    let (mut eij, mut geometric) = (EijEstimates::new(), EijEstimates::new());
     let (a, b) = plane.axes();
     for (col, dev) in [a, b, plane.normal()].into_iter().enumerate() {
         for (j, ax) in [a, b].into_iter().enumerate() {
             let key = Eij::new(dev, ax);
-            eij.insert(key, fit.coef[(j, col)]);
-            std_err.insert(key, fit.std_err(j, col));
-            geometric.insert(key, fit.coef[(2 + j, col)]);
-            geometric_se.insert(key, fit.std_err(2 + j, col));
+            eij.insert(key, fit.coef[(j, col)], fit.std_err(j, col));
+            geometric.insert(key, fit.coef[(2 + j, col)], fit.std_err(2 + j, col));
         }
     }
+    (eij, geometric)
 }
 
 /// Name of a geometric term, e.g. `GXZ`: deviation in X per mm of set position of Z.
@@ -254,7 +229,7 @@ impl PooledResult {
     /// `std_err_um_s2_per_m`, `geometric_um_per_mm`, `geometric_std_err_um_per_mm`,
     /// `rms_residual_um`, `cw_ccw_difference_sigma`, `warnings`.
     pub fn to_json(&self) -> serde_json::Value {
-        let g = |m: &BTreeMap<Eij, f64>| -> serde_json::Value {
+        let g = |m: &EijMap| -> serde_json::Value {
             serde_json::Value::Object(
                 m.iter()
                     .map(|(k, v)| (geometric_name(*k), serde_json::json!(v)))
@@ -266,10 +241,10 @@ impl PooledResult {
             "files": self.sources,
             "accel_m_s2": self.accel_m_s2,
             "directions": self.directions.iter().map(|d| d.name()).collect::<Vec<_>>(),
-            "eij_um_s2_per_m": super::eij_json(&self.eij),
-            "std_err_um_s2_per_m": super::eij_json(&self.std_err),
-            "geometric_um_per_mm": g(&self.geometric_um_per_mm),
-            "geometric_std_err_um_per_mm": g(&self.geometric_std_err),
+            "eij_um_s2_per_m": super::eij_json(&self.eij.value_map()),
+            "std_err_um_s2_per_m": super::eij_json(&self.eij.std_err_map()),
+            "geometric_um_per_mm": g(&self.geometric_um_per_mm.value_map()),
+            "geometric_std_err_um_per_mm": g(&self.geometric_um_per_mm.std_err_map()),
             "rms_residual_um": self.rms_residual_um,
             "cw_ccw_difference_sigma": super::eij_json(&self.cw_ccw_difference_sigma),
             "warnings": self.warnings,

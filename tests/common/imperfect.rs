@@ -154,11 +154,7 @@ pub fn tests(
                     accel_m_s2: r.accel_m_s2,
                     position_m: Some(t.position_mm.iter().map(|v| v * 1e-3).collect()),
                 },
-                measured: r
-                    .eij
-                    .iter()
-                    .map(|(p, v)| (*p, (*v, r.std_err[p])))
-                    .collect(),
+                measured: r.eij,
                 clock: Some("generated".into()),
             }
         })

@@ -5,11 +5,11 @@
 use super::{group_key, series_at, Data, Prepared, SuiteOptions};
 use crate::measured::inputs::TestInput;
 use crate::measured::MeasuredError;
-use crate::rtest::clock::{self, Recording as Record};
+use crate::rtest::clock::{self, Recording};
 use crate::rtest::clock_fit::{fit_offset, OffsetFit, OffsetTest};
 use crate::rtest::error::{Location, RtestError};
 use crate::rtest::normalise::{normalise, Normalised};
-use crate::rtest::{CircleSeries, EvalOptions};
+use crate::rtest::{CircleSeries, EvalOptions, Warning};
 
 /// How a test's clock offset was found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -82,7 +82,7 @@ pub struct ClockReport {
     /// The joint fit's χ² per degree of freedom, where fitted.
     pub chi2_per_dof: Option<f64>,
     /// Why (not) separable, and other remarks.
-    pub notes: Vec<String>,
+    pub notes: Vec<Warning>,
 }
 
 /// Trajectory alignments of one clock that differ by more than this are not one constant
@@ -94,7 +94,11 @@ const SAME_CLOCK_SPREAD_S: f64 = 2e-3;
 const UNIQUE_ALIGNMENT_RATIO: f64 = 3.0;
 
 /// The internal recording alone, as a series, to find its circle and period.
-fn internal_period(input: &TestInput, r: &Record, opts: &EvalOptions) -> Result<f64, RtestError> {
+fn internal_period(
+    input: &TestInput,
+    r: &Recording,
+    opts: &EvalOptions,
+) -> Result<f64, RtestError> {
     let s = CircleSeries::new(r.source.clone(), r.t_s.clone(), r.mm.clone(), r.mm.clone())?;
     let norm = normalise(&s, opts).map_err(|e| match e {
         RtestError::TooShort { detail, .. } => RtestError::TooShort {
@@ -162,12 +166,9 @@ pub(super) fn align_clock(
             .collect::<Result<Vec<_>, _>>()?;
         joint_offset(clock, &aligned, inputs, &norms)?
     } else {
-        notes.push(format!(
-            "the trajectory alignments of its tests differ by {:.3} ms: not one constant \
-             offset (clocks restarted or drifting), each test keeps its own, which cannot tell \
-             a clock offset from antisymmetric cross-talk",
-            spread * 1e3
-        ));
+        notes.push(Warning::AlignmentsDiffer {
+            spread_ms: spread * 1e3,
+        });
         None
     };
     let separable = fit.as_ref().is_some_and(|f| f.separable);
@@ -191,13 +192,10 @@ pub(super) fn align_clock(
     }
     if let Some(f) = &fit {
         if !f.separable {
-            notes.push(format!(
-                "offset {:.4} ms from the trajectories only: {}; the antisymmetric in-plane \
-                 cross-talk (e.g. EXZ − EZX) of these tests is not measured (an offset error δ \
-                 shifts it by 2·10⁶·δ/ω µm·s²/m)",
-                base * 1e3,
-                f.reason
-            ));
+            notes.push(Warning::ClockOffsetFromTrajectories {
+                offset_ms: base * 1e3,
+                reason: f.reason.clone(),
+            });
         }
     }
     Ok(vec![ClockReport {
@@ -299,19 +297,12 @@ pub(super) fn lag_of_clock(
             });
         }
     } else if significant {
-        notes.push(format!(
-            "the external readings are {:.4} ± {:.4} ms {} the internal ones ({}); not \
-             corrected (give --fit-time-offset, or time_offset_ms in rtest.toml): the \
-             antisymmetric in-plane cross-talk of these tests carries it",
-            fit.offset_s.abs() * 1e3,
-            fit.std_err_s * 1e3,
-            if fit.offset_s < 0.0 {
-                "late against"
-            } else {
-                "early against"
-            },
-            fit.reason
-        ));
+        notes.push(Warning::ClockOffsetNotCorrected {
+            offset_ms: fit.offset_s.abs() * 1e3,
+            std_err_ms: fit.std_err_s * 1e3,
+            external_late: fit.offset_s < 0.0,
+            reason: fit.reason.clone(),
+        });
     }
     Ok(vec![ClockReport {
         clock: clock.to_string(),

@@ -4,14 +4,14 @@
 //! test evaluated at its set radius, and cw/ccw pairs given their ISO 230-4 bi-directional
 //! circular deviation.
 
-use super::conditions::Recording;
+use super::conditions::DataFiles;
 use super::error::MeasuredError;
 use super::inputs::TestInput;
 use super::json::{CircleJson, TestJson, TimeOffsetJson};
 use crate::axes::{Direction, Eij, Plane};
-use crate::rtest::clock::{self, Recording as Record};
+use crate::rtest::clock::{self, Recording};
 use crate::rtest::normalise::Normalised;
-use crate::rtest::{evaluate, iso230, CircleResult, CircleSeries, EvalOptions};
+use crate::rtest::{evaluate, iso230, CircleResult, CircleSeries, EvalOptions, Named, Warning};
 use rayon::prelude::*;
 
 mod clocks;
@@ -76,7 +76,7 @@ pub struct EvaluatedTest {
     /// What the test's conditions and clock add to the evaluation's own warnings (also in
     /// `result.warnings`): a missing set radius, a direction or feed that disagree with the
     /// data, a clock offset not separable from cross-talk.
-    pub notes: Vec<String>,
+    pub notes: Vec<Warning>,
 }
 
 /// A cw/ccw pair with its ISO 230-4 bi-directional circular deviations.
@@ -99,8 +99,8 @@ pub struct Suite {
     pub clocks: Vec<ClockReport>,
     /// cw/ccw pairs (same plane, position, radius, acceleration within 5 %).
     pub bidirectional: Vec<Bidirectional>,
-    /// Warnings about the whole set (clocks).
-    pub warnings: Vec<String>,
+    /// Warnings about the whole set (clocks), each naming its clock.
+    pub warnings: Vec<Named>,
 }
 
 /// Accelerations closer than this ratio pair up as cw/ccw.
@@ -113,7 +113,10 @@ pub(super) struct Prepared {
 
 pub(super) enum Data {
     Single(CircleSeries),
-    Split { internal: Record, external: Record },
+    Split {
+        internal: Recording,
+        external: Recording,
+    },
 }
 
 fn eval_options(input: &TestInput, opts: &SuiteOptions) -> (EvalOptions, RadiusSource) {
@@ -145,9 +148,9 @@ pub fn evaluate_tests(inputs: &[TestInput], opts: &SuiteOptions) -> Result<Suite
         .par_iter()
         .map(|input| -> Result<Prepared, MeasuredError> {
             let (eval, source) = eval_options(input, opts);
-            let data = match &input.recording {
-                Recording::Single(_) => Data::Single(input.read_single()?),
-                Recording::Split { internal, external } => Data::Split {
+            let data = match &input.data {
+                DataFiles::Single(_) => Data::Single(input.read_single()?),
+                DataFiles::Split { internal, external } => Data::Split {
                     internal: super::recording::read_internal(internal, &input.internal_columns)?,
                     external: super::recording::read_external(external, &input.external_columns)?,
                 },
@@ -205,13 +208,11 @@ pub fn evaluate_tests(inputs: &[TestInput], opts: &SuiteOptions) -> Result<Suite
             .filter(|o| o.source == OffsetSource::Trajectory)
         {
             let (a, b) = result.plane.axes();
-            notes.push(format!(
-                "clock offset {:.4} ms from the trajectories only (its clock's tests cannot \
-                 separate it from cross-talk): {} − {} is not measured",
-                o.offset_ms,
-                Eij::new(a, b),
-                Eij::new(b, a)
-            ));
+            notes.push(Warning::TestOffsetFromTrajectories {
+                offset_ms: o.offset_ms,
+                ab: Eij::new(a, b),
+                ba: Eij::new(b, a),
+            });
         }
         result.warnings.extend(notes.iter().cloned());
         tests.push(EvaluatedTest {
@@ -228,9 +229,10 @@ pub fn evaluate_tests(inputs: &[TestInput], opts: &SuiteOptions) -> Result<Suite
         .iter()
         .filter(|c| !c.separable || !c.notes.is_empty())
         .flat_map(|c| {
-            c.notes
-                .iter()
-                .map(move |n| format!("clock {}: {n}", c.clock))
+            c.notes.iter().map(move |n| Named {
+                name: Some(format!("clock {}", c.clock)),
+                warning: n.clone(),
+            })
         })
         .collect();
     Ok(Suite {
@@ -264,50 +266,46 @@ pub(super) fn series_at(
 }
 
 /// A single-file series as its two recordings on the same clock.
-fn split_series(s: &CircleSeries) -> Result<(Record, Record), MeasuredError> {
+fn split_series(s: &CircleSeries) -> Result<(Recording, Recording), MeasuredError> {
     use crate::axes::Axis;
     let int = Axis::ALL.map(|a| s.int_mm(a).to_vec());
     let ext = Axis::ALL.map(|a| s.ext_mm(a).to_vec());
     Ok((
-        Record::new(s.source().to_string(), s.t_s().to_vec(), int)?,
-        Record::new(s.source().to_string(), s.t_s().to_vec(), ext)?,
+        Recording::new(s.source().to_string(), s.t_s().to_vec(), int)?,
+        Recording::new(s.source().to_string(), s.t_s().to_vec(), ext)?,
     ))
 }
 
 /// Warnings from comparing a test's stated conditions with its data.
-fn condition_warnings(input: &TestInput, r: &CircleResult, source: RadiusSource) -> Vec<String> {
+fn condition_warnings(input: &TestInput, r: &CircleResult, source: RadiusSource) -> Vec<Warning> {
     let mut w = Vec::new();
     if source == RadiusSource::InternalMean {
-        w.push(format!(
-            "no set radius given (rtest.toml radius_mm, or a set radius with the evaluation's \
-             options): EIJ are per the acceleration of the mean internal radius {:.4} mm, not per set acceleration",
-            r.radius_mm
-        ));
+        w.push(Warning::NoSetRadius {
+            mean_internal_radius_mm: r.radius_mm,
+        });
     }
     if source == RadiusSource::Fallback {
-        w.push(format!(
-            "no set radius in the test's conditions (rtest.toml radius_mm or [[test]]): the \
-             identification's default radius {:.4} mm (its settings' radius_mm, 2 mm unless set) is taken \
-             as the set radius; the data's mean internal radius is {:.4} mm",
-            r.radius_mm, r.measured_radius_mm
-        ));
+        w.push(Warning::DefaultRadius {
+            radius_mm: r.radius_mm,
+            mean_internal_radius_mm: r.measured_radius_mm,
+        });
     }
     if let Some(d) = input.direction {
         if d != r.direction {
-            w.push(format!(
-                "rtest.toml says {d}, the data turn {} (CONTRACT.md: ccw is ω > 0 in a = r cos ωt, \
-                 b = r sin ωt of plane {})",
-                r.direction, r.plane
-            ));
+            w.push(Warning::DirectionDisagrees {
+                stated: d,
+                measured: r.direction,
+                plane: r.plane,
+            });
         }
     }
     if let Some(feed) = input.feed_mm_min {
         let measured = r.freq_hz * std::f64::consts::TAU * r.radius_mm * 60.0;
         if (measured / feed - 1.0).abs() > 0.05 {
-            w.push(format!(
-                "programmed feed {feed} mm/min, the steady circle runs at {measured:.1} mm/min \
-                 (override, or the machine's limits)"
-            ));
+            w.push(Warning::FeedDisagrees {
+                programmed_mm_min: feed,
+                measured_mm_min: measured,
+            });
         }
     }
     w
