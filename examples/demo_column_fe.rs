@@ -15,7 +15,7 @@
 //! replaced by a `[body.fe]` table naming those files (same `modes`, `damping_ratio`,
 //! `stiffness_factor`). `tests/demo_flex.rs` checks that both machine files give the same EIJ.
 
-use eij::fe::{Beam, DofKind, FeModel, FePaths, Node};
+use eij::fe::{Beam, DofKind, FeModel, Node};
 use eij::Machine;
 use faer::sparse::{SparseColMat, Triplet};
 use std::path::Path;
@@ -114,15 +114,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
          nodes renumbered, equations ordered by direction",
         beam.elements
     );
-    model.write_files(
-        FePaths {
-            mass: &dir.join(file("M.mtx")),
-            stiffness: &dir.join(file("K.mtx")),
-            dofs: &dir.join(file("dofs.csv")),
-            nodes: &dir.join(file("nodes.csv")),
-        },
-        &comment,
-    )?;
+    let paths = ["M.mtx", "K.mtx", "dofs.csv", "nodes.csv"].map(|s| dir.join(file(s)));
+    model.write_files(paths.each_ref().map(|p| p.as_path()), &comment)?;
     let fe = format!(
         "[body.fe]\nmass_matrix = \"{DIR}/{}\"\nstiffness_matrix = \"{DIR}/{}\"\ndofs = \"{DIR}/{}\"\nnodes = \"{DIR}/{}\"\n",
         file("M.mtx"),

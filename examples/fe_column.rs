@@ -3,7 +3,7 @@
 //! With `--write DIR` the column's M, K (Matrix Market), DOF map and nodes are written there for
 //! `benches/fe_scipy.py`. 150 divisions along z give 64 779 DOFs; 470 give 202 059.
 
-use eij::fe::{free_free_frequencies_hz, reduce, FeModel, FePaths};
+use eij::fe::{free_free_frequencies_hz, reduce, FeModel};
 use std::time::Instant;
 
 #[path = "../benches/common/fe_column.rs"]
@@ -42,12 +42,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let dir = std::path::Path::new(dir);
         std::fs::create_dir_all(dir)?;
         model.write_files(
-            FePaths {
-                mass: &dir.join("column-M.mtx"),
-                stiffness: &dir.join("column-K.mtx"),
-                dofs: &dir.join("column-dofs.csv"),
-                nodes: &dir.join("column-nodes.csv"),
-            },
+            [
+                &dir.join("column-M.mtx"),
+                &dir.join("column-K.mtx"),
+                &dir.join("column-dofs.csv"),
+                &dir.join("column-nodes.csv"),
+            ],
             "eij examples/fe_column: hex8 column 0.6 x 0.5 x 3.0 m, E 1.2e11 Pa, nu 0.27, 7200 kg/m3",
         )?;
         let t = Instant::now();

@@ -51,42 +51,49 @@ impl FeModel {
     }
 }
 
-/// Where the four files of an exported FE model go (see [`FeModel::from_files`]).
-#[derive(Debug, Clone, Copy)]
-pub struct FePaths<'a> {
-    /// Matrix Market mass matrix.
-    pub mass: &'a Path,
-    /// Matrix Market stiffness matrix.
-    pub stiffness: &'a Path,
-    /// DOF map `node,dof`.
-    pub dofs: &'a Path,
-    /// Nodes `node,x_m,y_m,z_m`.
-    pub nodes: &'a Path,
-}
-
 impl FeModel {
-    /// Writes the model as an FE program exports it, the files [`FeModel::from_files`] reads:
-    /// M and K as `coordinate real symmetric` Matrix Market (17 digits, `comment` in their
-    /// header), the DOF map in row order and the nodes (shortest round-trip decimals).
-    pub fn write_files(&self, to: FePaths, comment: &str) -> std::io::Result<()> {
-        for (path, a) in [(to.mass, &self.mass), (to.stiffness, &self.stiffness)] {
-            let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
-            mtx::write_symmetric(&mut out, a, comment)?;
-            std::io::Write::flush(&mut out)?;
+    /// Writes the model as an FE program would export it, in the layout
+    /// [`FeModel::from_files`] reads: M and K as Matrix Market `coordinate real symmetric`
+    /// (lower triangle, 17 digits, `comment` as `%` lines), the DOF map `node,dof` and the nodes
+    /// `node,x_m,y_m,z_m`. The four files are written as one set (all or none,
+    /// [`crate::io::write_set`]).
+    pub fn write_files(
+        &self,
+        [mass, stiffness, dofs, nodes]: [&Path; 4],
+        comment: &str,
+    ) -> Result<(), crate::io::WriteError> {
+        let matrix = |a: &super::SparseMatrix| {
+            let mut out = Vec::new();
+            mtx::write_symmetric(&mut out, a, comment).map(|()| out)
+        };
+        fn io(path: &Path) -> impl Fn(std::io::Error) -> crate::io::WriteError + '_ {
+            move |cause| crate::io::WriteError::Io {
+                path: path.to_path_buf(),
+                cause,
+            }
         }
-        let mut dofs = String::from("node,dof\n");
+        let m = matrix(&self.mass).map_err(io(mass))?;
+        let k = matrix(&self.stiffness).map_err(io(stiffness))?;
+        let mut map = String::from("node,dof\n");
         for (i, kind) in &self.dofs {
-            dofs += &format!("{},{}\n", self.nodes[*i].id, kind.name());
+            map += &format!("{},{}\n", self.nodes[*i].id, kind.name());
         }
-        std::fs::write(to.dofs, dofs)?;
-        let mut nodes = String::from("node,x_m,y_m,z_m\n");
+        let mut list = String::from("node,x_m,y_m,z_m\n");
         for p in &self.nodes {
-            nodes += &format!(
-                "{},{},{},{}\n",
+            list += &format!(
+                "{},{:?},{:?},{:?}\n",
                 p.id, p.position.x, p.position.y, p.position.z
             );
         }
-        std::fs::write(to.nodes, nodes)
+        crate::io::write_set(
+            &[
+                (mass, &m),
+                (stiffness, &k),
+                (dofs, map.as_bytes()),
+                (nodes, list.as_bytes()),
+            ],
+            &[],
+        )
     }
 }
 

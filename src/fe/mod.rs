@@ -31,7 +31,6 @@ mod sparse;
 
 pub use attach::{Attachment, AttachmentKind, Station};
 pub use beam::Beam;
-pub use files::FePaths;
 pub use hex8::Hex8Block;
 pub use reduce::{
     reduce, FeSummary, ReducedBody, ReductionSettings, StationSummary, CUTOFF_MARGIN,

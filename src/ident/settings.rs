@@ -179,6 +179,14 @@ pub const DETERMINED_REL_STD_ERR: f64 = 0.1;
 /// deviations √(2/(m − n)).
 pub const CHI2_SIGMAS: f64 = 4.0;
 
+/// The interval of an identified factor is its value ± this many standard errors, taken in the
+/// compliance θ = 1/p and mapped to p ([`super::verdict::factor_interval`]).
+pub const INTERVAL_SIGMAS: f64 = 3.0;
+
+/// With a failed χ² test, a static term or clock offset beyond this many standard errors says
+/// that it may be absorbing a model error ([`super::mismatch`]).
+pub const MISMATCH_SIGMAS: f64 = 3.0;
+
 /// Harmonic and time-domain EIJ of the final model must agree within this fraction of the
 /// value …
 pub const CONFIRM_REL: f64 = 0.01;

@@ -194,6 +194,32 @@ pub fn implausible(name: &str, value: f64) -> bool {
     Implausible::of(name, value).is_some()
 }
 
+/// The interval p ∈ [low, high] of a factor identified as `value` ± `std_err`, `k` standard
+/// errors wide, taken where the fit is linear — in the compliance θ = 1/p, σ_θ = σ_p·θ²
+/// (the delta method the standard error came from) — and mapped back:
+/// low = 1/(θ + k·σ_θ), high = 1/(θ − k·σ_θ). Asymmetric: a loosely determined factor of
+/// 0.5 ± 0.1 (σ_θ = 0.4) spans [0.31, 1.25] at 3σ, not 0.5 ± 0.3. `high` is `None` (unbounded)
+/// when θ − k·σ_θ ≤ 0: the data cannot exclude an element that does not yield at all. `None`
+/// for a value that is not positive or a standard error that is not finite.
+pub fn factor_interval(value: f64, std_err: f64, k: f64) -> Option<(f64, Option<f64>)> {
+    if !(value > 0.0 && std_err.is_finite() && std_err >= 0.0) {
+        return None;
+    }
+    let theta = 1.0 / value;
+    let sigma_theta = std_err * theta * theta;
+    let low = 1.0 / (theta + k * sigma_theta);
+    let upper = theta - k * sigma_theta;
+    Some((low, (upper > 0.0).then(|| 1.0 / upper)))
+}
+
+/// `[0.316, 0.529]` or `[0.316, ∞)`.
+pub fn format_interval(interval: (f64, Option<f64>)) -> String {
+    match interval.1 {
+        Some(high) => format!("[{:.4}, {:.4}]", interval.0, high),
+        None => format!("[{:.4}, ∞)", interval.0),
+    }
+}
+
 /// The χ² test of a fit.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Chi2 {

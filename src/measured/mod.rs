@@ -24,6 +24,7 @@
 
 pub mod conditions;
 pub mod error;
+pub mod history;
 pub mod inputs;
 pub mod json;
 pub mod layout;

@@ -11,6 +11,7 @@ use std::fmt::Write as _;
 use super::page::escape;
 use crate::rtest::diagnosis::tolerance::Verdict;
 use crate::rtest::diagnosis::{CircleDiagnosis, Figure, Source, SourceDiagnosis, Term};
+use crate::text::unit_symbol;
 
 /// CSS class of a passed test or term.
 pub const PASS: &str = "v-pass";
@@ -56,7 +57,7 @@ pub fn failed_checks(v: &Verdict) -> Vec<String> {
                 c.source.name(),
                 c.value,
                 super::short(c.limit, 4),
-                unit(c.unit)
+                unit_symbol(c.unit)
             )
         })
         .collect()
@@ -68,15 +69,6 @@ fn source_head(s: Source) -> &'static str {
         Source::Internal => "axes<br><small>internal</small>",
         Source::Structure => "structure<br><small>external − internal</small>",
         Source::Tcp => "TCP<br><small>as a ballbar sees it</small>",
-    }
-}
-
-/// A unit as written on the page (`um` → µm).
-fn unit(u: &str) -> &str {
-    match u {
-        "um" => "µm",
-        "um_per_m" => "µm/m",
-        other => other,
     }
 }
 
@@ -204,7 +196,7 @@ pub fn breakdown_html(d: &CircleDiagnosis, verdict: Option<&Verdict>, label: &st
             h,
             "<tr><th class=\"l\">{}</th><td class=\"l\">{}</td>",
             escape(&name),
-            unit(unit_of)
+            unit_symbol(unit_of)
         );
         for s in &d.sources {
             h.push_str(&cell(s.term(&name)));
