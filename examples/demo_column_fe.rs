@@ -114,15 +114,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
          nodes renumbered, equations ordered by direction",
         beam.elements
     );
-    model.write_files(
-        [
-            &dir.join(file("M.mtx")),
-            &dir.join(file("K.mtx")),
-            &dir.join(file("dofs.csv")),
-            &dir.join(file("nodes.csv")),
-        ],
-        &comment,
-    )?;
+    let paths = ["M.mtx", "K.mtx", "dofs.csv", "nodes.csv"].map(|s| dir.join(file(s)));
+    model.write_files(paths.each_ref().map(|p| p.as_path()), &comment)?;
     let fe = format!(
         "[body.fe]\nmass_matrix = \"{DIR}/{}\"\nstiffness_matrix = \"{DIR}/{}\"\ndofs = \"{DIR}/{}\"\nnodes = \"{DIR}/{}\"\n",
         file("M.mtx"),
