@@ -180,7 +180,8 @@ pub fn write_tables(dir: &std::path::Path, tests: &[TestCase]) -> Vec<std::path:
                 centres.len() - 1
             }
         };
-        for (eij, (v, se)) in &t.measured {
+        for (eij, e) in &t.measured {
+            let (v, se) = (e.value, e.std_err);
             tables[k].push_str(&format!(
                 "{},{},{},{eij},{v:.6},{se:.6}\n",
                 t.circle.plane,
