@@ -410,3 +410,57 @@ fn the_move_plots_header_states_the_planned_profile_the_console_prints() {
         .fold(0.0f64, |m, x| m.max(x.abs()));
     assert!(peak <= a + 1e-3 && peak > a - 0.3, "CSV peak {peak} vs {a}");
 }
+
+#[test]
+fn the_move_prints_the_tcps_path_deviation_with_and_without_the_table() {
+    // Issue 29 item 2: eij itself shows what the compensation reduces, the TCP's deviation
+    // from the nominal path, as README and docs/compensation.md state it (3.5 → 0.12 µm in X,
+    // 9.9 → 0.36 µm in Y: 29× and 27×). Independent: max |ext − set| of the written series
+    // of a plain and of a compensated run.
+    let (s, _, table) = identified();
+    let (plain, comp, svg) = (s.s("dev-plain.csv"), s.s("dev-comp.csv"), s.s("dev.svg"));
+    let p = z_move_run(&plain, "0,0,0", &[]);
+    let c = z_move_run(&comp, "0,0,0", &["--compensation", table, "--plot", &svg]);
+    assert!(p.ok && c.ok, "{}{}", p.stderr, c.stderr);
+    let (p_cols, c_cols) = (columns(&plain), columns(&comp));
+    let line = |r: &common::Run| -> String {
+        r.stderr
+            .lines()
+            .find(|l| l.contains("TCP deviation from the nominal path"))
+            .unwrap_or_else(|| panic!("no deviation line in {}", r.stderr))
+            .to_string()
+    };
+    let (pl, cl) = (line(&p), line(&c));
+    for (axis, before, after, factor) in [("x", 3.5, 0.12, 29.0), ("y", 9.9, 0.36, 27.0)] {
+        let (w, m) = (worst_um(&p_cols, axis), worst_um(&c_cols, axis));
+        // The documented figures, from the series.
+        assert!(
+            (w - before).abs() < 0.05 && (m - after).abs() < 0.005,
+            "{axis}: {w} → {m}"
+        );
+        assert_eq!((w / m).round(), factor, "{axis}: {w} / {m}");
+        // The console says the same, plain and compensated.
+        let part = |l: &str| -> Vec<f64> {
+            let at = l
+                .find(&format!(" {axis} "))
+                .unwrap_or_else(|| panic!("{l}"));
+            numbers(&l[at + 2..]).into_iter().take(3).collect()
+        };
+        let (pn, cn) = (part(&pl), part(&cl));
+        assert!((pn[0] - w).abs() < 6e-4, "{pl}: {w}");
+        assert!(
+            (cn[0] - w).abs() < 6e-4 && (cn[1] - m).abs() < 6e-4,
+            "{cl}: {w} → {m}"
+        );
+        assert_eq!(cn[2], factor, "{cl}");
+    }
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(
+        text.contains("without compensation (TCP − nominal path)"),
+        "{svg}"
+    );
+    assert!(
+        text.contains("with compensation (TCP − nominal path)"),
+        "{svg}"
+    );
+}
