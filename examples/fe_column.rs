@@ -3,7 +3,7 @@
 //! With `--write DIR` the column's M, K (Matrix Market), DOF map and nodes are written there for
 //! `benches/fe_scipy.py`. 150 divisions along z give 64 779 DOFs; 470 give 202 059.
 
-use eij::fe::{free_free_frequencies_hz, mtx, reduce, FeModel};
+use eij::fe::{free_free_frequencies_hz, reduce, FeModel};
 use std::time::Instant;
 
 #[path = "../benches/common/fe_column.rs"]
@@ -41,26 +41,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Some(dir) = write {
         let dir = std::path::Path::new(dir);
         std::fs::create_dir_all(dir)?;
-        for (name, a) in [
-            ("column-M.mtx", &model.mass),
-            ("column-K.mtx", &model.stiffness),
-        ] {
-            let mut out = std::io::BufWriter::new(std::fs::File::create(dir.join(name))?);
-            mtx::write_symmetric(&mut out, a, "eij examples/fe_column: hex8 column 0.6 x 0.5 x 3.0 m, E 1.2e11 Pa, nu 0.27, 7200 kg/m3")?;
-        }
-        let mut dofs = String::from("node,dof\n");
-        for (i, kind) in &model.dofs {
-            dofs += &format!("{},{}\n", model.nodes[*i].id, kind.name());
-        }
-        std::fs::write(dir.join("column-dofs.csv"), dofs)?;
-        let mut nodes = String::from("node,x_m,y_m,z_m\n");
-        for p in &model.nodes {
-            nodes += &format!(
-                "{},{},{},{}\n",
-                p.id, p.position.x, p.position.y, p.position.z
-            );
-        }
-        std::fs::write(dir.join("column-nodes.csv"), nodes)?;
+        model.write_files(
+            [
+                &dir.join("column-M.mtx"),
+                &dir.join("column-K.mtx"),
+                &dir.join("column-dofs.csv"),
+                &dir.join("column-nodes.csv"),
+            ],
+            "eij examples/fe_column: hex8 column 0.6 x 0.5 x 3.0 m, E 1.2e11 Pa, nu 0.27, 7200 kg/m3",
+        )?;
         let t = Instant::now();
         let back = FeModel::from_files(
             &dir.join("column-M.mtx"),

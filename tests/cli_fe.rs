@@ -163,7 +163,7 @@ fn the_words_count_the_modes_the_numbers_show_within_a_tenth_of_a_percent() {
         .count();
     let r = run(&["fe", "--machine", &machine, "--body", "column"]);
     assert!(r.ok, "{}", r.stderr);
-    let said = format!("Resolution: the lowest {within} modes");
+    let said = format!("Resolution: within 0.1 % of the full model: the lowest {within} modes");
     assert!(r.stdout.contains(&said), "{said} not in:\n{}", r.stdout);
     assert!(r.stdout.contains("keep more modes"), "{}", r.stdout);
 }

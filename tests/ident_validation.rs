@@ -3,7 +3,7 @@
 //! held-out groups' static terms are fitted on them (generalised least squares).
 
 use eij::ident::validation::{validate, HeldOut, ParameterCovariance};
-use eij::ident::{identify, IdentResult, Parameter, Problem, Settings, TestCase};
+use eij::ident::{Problem, TestCase};
 use nalgebra::{DMatrix, DVector};
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
@@ -100,25 +100,13 @@ fn demo_tests(folder: &str) -> Vec<TestCase> {
     eij::ident::measured::load(&[path], &Default::default()).unwrap()
 }
 
-fn fit(tests: Vec<TestCase>) -> (Problem, IdentResult) {
-    let base = common::demo();
-    let settings = Settings {
-        design: false,
-        ..Default::default()
-    };
-    let problem =
-        Problem::new(base.clone(), Parameter::default_set(&base), tests, settings).unwrap();
-    let result = identify(&problem, None).unwrap();
-    (problem, result)
-}
-
 #[test]
 fn the_exact_demo_model_passes_hold_out_validation_both_ways() {
     // Before the parameters' covariance was counted, pos-a → pos-b failed (χ²/dof = 1.74
     // over 89 degrees of freedom) while the reverse passed, on the very model that generated
     // the data. The pass limit is 1 + 4·√(2/dof).
     for (fitted, held) in [("pos-a", "pos-b"), ("pos-b", "pos-a")] {
-        let (problem, result) = fit(demo_tests(fitted));
+        let (problem, result) = common::fit_demo(demo_tests(fitted));
         let cov = ParameterCovariance::of(problem.parameters(), &result);
         let v = validate(
             &result.machine,
@@ -153,7 +141,7 @@ fn the_exact_demo_model_passes_hold_out_validation_both_ways() {
 fn the_prediction_variance_matches_simulations_of_parameters_drawn_from_their_covariance() {
     // Independent of the Jacobian: draw θ ~ N(θ̂, Σ), simulate the held-out tests, and compare
     // the summed variance of the simulated EIJ with Σ over tests of count·rms σ_pred².
-    let (problem, result) = fit(demo_tests("pos-a"));
+    let (problem, result) = common::fit_demo(demo_tests("pos-a"));
     let cov = ParameterCovariance::of(problem.parameters(), &result);
     let held = demo_tests("pos-b");
     let v = validate(

@@ -115,8 +115,10 @@ fn breakdown_beside_each_plot_verdict_first() {
             bx["std_err"].as_f64().unwrap(),
         );
         let row_bx = between(block, "<th class=\"l\">backlash_x</th>", "</tr>");
+        // Two significant digits of the standard error.
+        let d = (1.0 - se.log10().floor()) as usize;
         let cell = format!(
-            "<td class=\"v-{}\">{v:.3} ± {se:.3}",
+            "<td class=\"v-{}\">{v:.d$} ± {se:.d$}",
             bx["verdict"].as_str().unwrap()
         );
         assert!(row_bx.contains(&cell), "{label}: {cell} in {row_bx}");

@@ -6,74 +6,14 @@
 
 mod common;
 
-use std::collections::BTreeMap;
-
 use common::circle_terms::{axis, Errors, TermCircle};
+use common::diagnosis_checks::{check, diagnose, expect, opts, term, within, Expected, PITCH_MM};
 use eij::axes::{Direction, Plane};
 use eij::control::ClosedLoop;
 use eij::machine::Machine;
-use eij::rtest::diagnosis::{
-    diagnose_series, separate, CircleDiagnosis, DiagnosisOptions, Source, SourceDiagnosis,
-};
+use eij::rtest::diagnosis::{diagnose_series, separate, CircleDiagnosis, DiagnosisOptions, Source};
 use eij::rtest::{evaluate, EvalOptions};
 use eij::sim::harmonic;
-
-const PITCH_MM: f64 = 0.5;
-
-fn opts() -> DiagnosisOptions {
-    DiagnosisOptions {
-        cyclic_pitch_mm: Some(PITCH_MM),
-        ..Default::default()
-    }
-}
-
-fn diagnose(c: &TermCircle) -> CircleDiagnosis {
-    let eval = EvalOptions {
-        radius_mm: Some(c.radius_mm),
-        ..Default::default()
-    };
-    diagnose_series(&c.series(), &eval, &opts()).unwrap()
-}
-
-/// Expected values per term name (others 0).
-type Expected = BTreeMap<String, f64>;
-
-/// Amplitudes are ≥ 0 (Rayleigh-distributed about 0): not in the z-score statistics.
-fn is_amplitude(name: &str) -> bool {
-    name.starts_with("cyclic") || name == "out_of_plane_tilt" || name == "out_of_plane_saddle"
-}
-
-/// Checks one source: expected terms within 3 se, the others within 4 se of 0 (hundreds of
-/// checks: 4 se keeps chance failures below 1 in 10⁴ each). Returns the z-scores of the
-/// terms expected to be 0 (not amplitudes).
-fn check(what: &str, d: &SourceDiagnosis, expected: &Expected) -> Vec<f64> {
-    let mut zeros = Vec::new();
-    for t in &d.terms {
-        let truth = expected.get(&t.name).copied().unwrap_or(0.0);
-        let z = (t.value - truth) / t.std_err;
-        let bound = if expected.contains_key(&t.name) {
-            3.0
-        } else {
-            4.0
-        };
-        assert!(
-            z.abs() < bound,
-            "{what}: {} = {:.4} ± {:.4} {}, expected {truth} (z = {z:.2})",
-            t.name,
-            t.value,
-            t.std_err,
-            t.unit
-        );
-        if !expected.contains_key(&t.name) && !is_amplitude(&t.name) {
-            zeros.push(z);
-        }
-    }
-    zeros
-}
-
-fn expect(pairs: &[(String, f64)]) -> Expected {
-    pairs.iter().cloned().collect()
-}
 
 /// One error alone in one source: (label, errors, expected terms), for plane `plane`.
 fn single_cases(plane: Plane) -> Vec<(String, Errors, Expected)> {
@@ -387,21 +327,6 @@ fn terms_reproduce_the_path_and_its_g() {
             );
         }
     }
-}
-
-fn term(d: &CircleDiagnosis, source: Source, name: &str) -> (f64, f64) {
-    let t = d
-        .source(source)
-        .term(name)
-        .unwrap_or_else(|| panic!("{name} in {source:?}"));
-    (t.value, t.std_err)
-}
-
-fn within(what: &str, (v, se): (f64, f64), truth: f64, k: f64) {
-    assert!(
-        (v - truth).abs() < k * se,
-        "{what}: {v:.4} ± {se:.4}, expected {truth}"
-    );
 }
 
 /// A cw/ccw pair: the axes' 45° ellipse splits into squareness (the same in both directions)

@@ -207,6 +207,15 @@ fn cutoff_hz(raw: &RawBody) -> Option<f64> {
     }
 }
 
+/// "the first mode (817.0 Hz)" or "the lowest 9 modes (up to 2806.4 Hz)".
+fn lowest(count: usize, top_hz: f64) -> String {
+    if count == 1 {
+        format!("the first mode ({top_hz:.1} Hz)")
+    } else {
+        format!("the lowest {count} modes (up to {top_hz:.1} Hz)")
+    }
+}
+
 /// How well the reduction resolves the body, in words: how far up the lowest modes agree with
 /// the full model, and (with `cutoff_hz`) the modes below half the cutoff.
 fn resolution(s: &FeSummary, d: &[f64], cutoff_hz: Option<f64>) -> String {
@@ -232,19 +241,18 @@ fn resolution(s: &FeSummary, d: &[f64], cutoff_hz: Option<f64>) -> String {
             worst.0 + 1
         );
     } else {
-        if close > 0 {
-            w += &format!(
-                "the lowest {close} modes (up to {:.1} Hz) agree with the full model within 0.1 %",
-                hz(close)
-            );
-        } else {
-            w += "not even the first mode agrees with the full model within 0.1 %";
-        }
-        if fair > close {
-            w += &format!(", the lowest {fair} (up to {:.1} Hz) within 1 %", hz(fair));
-        }
+        w += &match (close, fair) {
+            (0, 0) => "not even the first mode is within 1 % of the full model".to_string(),
+            (0, f) => format!("within 1 % of the full model: {}", lowest(f, hz(f))),
+            (c, f) if f > c => format!(
+                "within 0.1 % of the full model: {}; within 1 %: {}",
+                lowest(c, hz(c)),
+                lowest(f, hz(f))
+            ),
+            (c, _) => format!("within 0.1 % of the full model: {}", lowest(c, hz(c))),
+        };
         w += &format!(
-            "; the largest difference is {:+.2} % (mode {}, {:.1} Hz). Above that the reduced body is \
+            "; the largest difference is {:+.2} % (mode {}, {:.1} Hz). Above these the reduced body is \
              stiffer than the full model: keep more modes (`modes`, `cutoff_hz`) if the machine's \
              dynamics reach there.",
             100.0 * worst.1,

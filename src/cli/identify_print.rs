@@ -8,7 +8,7 @@
 use eij::ident::design::Design;
 use eij::ident::report::IdentReport;
 use eij::ident::validation::Validation;
-use eij::ident::verdict::{implausible, Standing};
+use eij::ident::verdict::{format_interval, implausible, Standing};
 use eij::ident::{IdentResult, Problem};
 use eij::rtest::pooled::geometric_name;
 use eij::Estimate;
@@ -69,41 +69,47 @@ fn print_verdict(p: &Problem, result: &IdentResult, report: &IdentReport, second
     if let Some(c) = report.chi2() {
         outln!("χ² test {}", c.describe());
     }
-    outln!("\n  parameter              initial   identified    std err   σ/value  standing");
+    outln!(
+        "\n  parameter              initial   identified    std err   σ/value   3σ interval (in 1/p)  standing"
+    );
     for q in &report.parameters {
         let standing = report.standing(q);
         let rel = standing
             .rel_std_err()
             .map_or("-".to_string(), |r| format!("{:.1} %", 100.0 * r));
-        let plausible = if standing != Standing::NotIdentifiable && implausible(q.identified) {
-            ", implausible factor"
-        } else {
-            ""
-        };
+        let plausible =
+            if standing != Standing::NotIdentifiable && implausible(&q.name, q.identified) {
+                ", implausible factor"
+            } else {
+                ""
+            };
+        let interval = q.interval().map_or("-".to_string(), format_interval);
         match q.std_err {
             Some(s) => outln!(
-                "  {:<22} {:>7.4}   {:>10.4}   {:>8.4}  {:>8}  {}{plausible}",
+                "  {:<22} {:>7.4}   {:>10.4}   {:>8.4}  {:>8}   {:<20}  {}{plausible}",
                 q.name,
                 q.initial,
                 q.identified,
                 s,
                 rel,
+                interval,
                 standing.label()
             ),
             None => outln!(
-                "  {:<22} {:>7.4}   {:>10.4}   {:>8}  {:>8}  {} (kept at its start value)",
+                "  {:<22} {:>7.4}   {:>10.4}   {:>8}  {:>8}   {:<20}  {} (kept at its start value)",
                 q.name,
                 q.initial,
                 q.identified,
                 "-",
                 rel,
+                interval,
                 standing.label()
             ),
         }
     }
     let legend = Standing::legend();
     let (a, b) = legend.split_once("; ").unwrap_or((&legend, ""));
-    outln!("  ({a};\n   {b})");
+    outln!("  ({a};\n   {b};\n   {})", interval_legend());
     let n = result.parameters.len();
     let strong: Vec<String> = (0..n)
         .flat_map(|i| (i + 1..n).map(move |k| (i, k)))
@@ -127,6 +133,14 @@ fn print_verdict(p: &Problem, result: &IdentResult, report: &IdentReport, second
         0 => outln!("\nwarnings: none"),
         k => outln!("\nwarnings: {k} (on standard error above; also in the report JSON)"),
     }
+}
+
+/// What the 3σ interval column means.
+pub(super) fn interval_legend() -> String {
+    format!(
+        "3σ interval: the value ± {:.0} standard errors taken in the compliance 1/p, where the fit is linear, and mapped to p: asymmetric, ∞ where the data cannot exclude an element that does not yield",
+        eij::ident::settings::INTERVAL_SIGMAS
+    )
 }
 
 /// The full correlation matrix.

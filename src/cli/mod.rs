@@ -34,6 +34,7 @@ pub mod evaluate_diagnosis;
 mod evaluate_move;
 mod export;
 mod fe;
+mod history;
 mod identify;
 mod identify_print;
 mod machine_args;
@@ -83,6 +84,8 @@ enum Command {
     Compensation(compensation::CompensationArgs),
     /// Write an offline HTML report with SVG figures (circle tests, moves, identification).
     Report(report::ReportArgs),
+    /// Line up dated evaluations of one machine: diagnosis terms and EIJ over time, drift.
+    History(history::HistoryArgs),
 }
 
 impl Cli {
@@ -102,6 +105,7 @@ impl Cli {
             Command::Verify(args) => identify::verify(args),
             Command::Map(args) => map::run(args),
             Command::Report(args) => report::run(args),
+            Command::History(args) => history::run(args),
             Command::Stiffness(args) => stiffness::run(args),
             Command::Compensation(args) => compensation::run(args),
         }

@@ -1,5 +1,5 @@
 //! `eij report --measured PATH... [--identify-report FILE.json]... [--move FILE.csv...]
-//! [--map FILE.csv...] --out DIR`
+//! [--map FILE.csv...] [--history RUN...] --out DIR`
 
 use std::path::PathBuf;
 
@@ -12,7 +12,7 @@ use eij::report::{self, ReportRequest};
     clap::ArgGroup::new("inputs")
         .required(true)
         .multiple(true)
-        .args(["measured", "identify_report", "moves", "maps"])
+        .args(["measured", "identify_report", "moves", "maps", "history"])
 ))]
 pub struct ReportArgs {
     /// R-Test CSV files or folders of them (folders: every *.csv, sorted; a folder's
@@ -30,6 +30,11 @@ pub struct ReportArgs {
     /// EIJ maps (`eij map` compensation tables), one figure each.
     #[arg(long = "map", value_name = "FILE.csv", num_args = 1..)]
     maps: Vec<PathBuf>,
+    /// Dated runs of one machine, lined up in a history section (each EIJ and diagnosis term
+    /// over time, drift flagged): folders whose rtest.toml gives a `date`, or the output of
+    /// `eij evaluate … --diagnose --json`; at least two.
+    #[arg(long, value_name = "RUN", num_args = 2..)]
+    history: Vec<PathBuf>,
     /// Report folder: report.html, one self-contained page with every figure inline (created
     /// if missing; only report.html in it is replaced).
     #[arg(long, value_name = "DIR")]
@@ -48,6 +53,7 @@ pub fn run(args: ReportArgs) -> anyhow::Result<()> {
         identify_reports: args.identify_report,
         moves: args.moves,
         extra_figures: map_figures(&args.maps)?,
+        history: args.history,
         out_dir: args.out,
     })?;
     drop(spinner);

@@ -82,5 +82,26 @@ pub fn text(machine: &Machine, table: &StiffnessTable) -> String {
         s.push_str(&screws.join("\n  "));
         s.push('\n');
     }
+    let elastic: Vec<String> = machine
+        .bodies()
+        .iter()
+        .filter_map(|b| b.elastic().map(|e| (b, e)))
+        .map(|(b, e)| {
+            format!(
+                "{:<10} stiffness_factor {:.4} ({} elastic coordinates; `eij fe --body {}`)",
+                b.name,
+                e.stiffness_factor(),
+                e.modes(),
+                b.name
+            )
+        })
+        .collect();
+    if !elastic.is_empty() {
+        s.push_str(
+            "\nElastic bodies (the factor scales the body's whole FE stiffness, E and G alike; not in the CSV):\n  ",
+        );
+        s.push_str(&elastic.join("\n  "));
+        s.push('\n');
+    }
     s
 }

@@ -51,6 +51,52 @@ impl FeModel {
     }
 }
 
+impl FeModel {
+    /// Writes the model as an FE program would export it, in the layout
+    /// [`FeModel::from_files`] reads: M and K as Matrix Market `coordinate real symmetric`
+    /// (lower triangle, 17 digits, `comment` as `%` lines), the DOF map `node,dof` and the nodes
+    /// `node,x_m,y_m,z_m`. The four files are written as one set (all or none,
+    /// [`crate::io::write_set`]).
+    pub fn write_files(
+        &self,
+        [mass, stiffness, dofs, nodes]: [&Path; 4],
+        comment: &str,
+    ) -> Result<(), crate::io::WriteError> {
+        let matrix = |a: &super::SparseMatrix| {
+            let mut out = Vec::new();
+            mtx::write_symmetric(&mut out, a, comment).map(|()| out)
+        };
+        fn io(path: &Path) -> impl Fn(std::io::Error) -> crate::io::WriteError + '_ {
+            move |cause| crate::io::WriteError::Io {
+                path: path.to_path_buf(),
+                cause,
+            }
+        }
+        let m = matrix(&self.mass).map_err(io(mass))?;
+        let k = matrix(&self.stiffness).map_err(io(stiffness))?;
+        let mut map = String::from("node,dof\n");
+        for (i, kind) in &self.dofs {
+            map += &format!("{},{}\n", self.nodes[*i].id, kind.name());
+        }
+        let mut list = String::from("node,x_m,y_m,z_m\n");
+        for p in &self.nodes {
+            list += &format!(
+                "{},{:?},{:?},{:?}\n",
+                p.id, p.position.x, p.position.y, p.position.z
+            );
+        }
+        crate::io::write_set(
+            &[
+                (mass, &m),
+                (stiffness, &k),
+                (dofs, map.as_bytes()),
+                (nodes, list.as_bytes()),
+            ],
+            &[],
+        )
+    }
+}
+
 fn rename(e: FeError, file: &str) -> FeError {
     match e {
         FeError::File { message, .. } => FeError::file(file, message),

@@ -211,10 +211,13 @@ pub fn reduce(
     factor.l_solve(y.as_mut());
     let (q, diag) = orthonormal(y.as_ref());
     let top = diag.iter().fold(0.0f64, |a, &d| a.max(d));
-    if diag.iter().any(|&d| !(d > 1e-10 * top)) {
-        return Err(fail(
+    if let Some(k) = diag.iter().position(|&d| !(d > 1e-10 * top)) {
+        return Err(dependent_station(
             model,
-            "the attachments' stations are not independent (two attachments share their nodes?)",
+            attachments,
+            &stations,
+            &resolved,
+            k / 6,
         ));
     }
     let r = y.qr().R().to_owned();
@@ -306,6 +309,43 @@ pub fn reduce(
         body.add_full_reference(model)?;
     }
     Ok(body)
+}
+
+/// The error for station `j`, whose motion the stations before it already fix (QR column
+/// of W K⁻¹ Wᵀ that vanishes): which attachments use it, on which nodes.
+fn dependent_station(
+    model: &FeModel,
+    attachments: &[Attachment],
+    stations: &[super::Station],
+    resolved: &[Resolved],
+    j: usize,
+) -> FeError {
+    let users: Vec<&str> = attachments
+        .iter()
+        .zip(resolved)
+        .filter(|(_, r)| r.stations.iter().any(|s| s.1 == j))
+        .map(|(a, _)| a.name.as_str())
+        .collect();
+    let st = &stations[j];
+    let nodes: Vec<String> = st
+        .nodes
+        .iter()
+        .map(|&i| model.nodes[i].id.to_string())
+        .collect();
+    let c = st.reference_m;
+    fail(
+        model,
+        format!(
+            "the attachments' stations are not independent: the station of {} at ({:.4}, {:.4}, {:.4}) m \
+             (nodes {}) moves only as the stations of other attachments make it (patches that share \
+             most of their nodes: a smaller attach_radius_m, points further apart, or a finer mesh there)",
+            users.join(", "),
+            c.x,
+            c.y,
+            c.z,
+            nodes.join(" ")
+        ),
+    )
 }
 
 fn diagonal(a: &super::SparseMatrix, i: usize) -> f64 {

@@ -4,7 +4,8 @@
 
 use super::identifiability::Analysis;
 use super::parameters::to_factor;
-use super::settings::{Settings, AT_BOUND_REL, PLAUSIBLE_MAX, PLAUSIBLE_MIN};
+use super::settings::{Settings, AT_BOUND_REL};
+use super::verdict::Implausible;
 use super::{IdentError, Identified, Problem};
 use nalgebra::DVector;
 
@@ -108,8 +109,9 @@ pub(super) fn refusal(
     })
 }
 
-/// Warnings on identified factors: on a bound, stiffer than the catalogue (above
-/// [`PLAUSIBLE_MAX`]) or more than ten times softer (below [`PLAUSIBLE_MIN`]).
+/// Warnings on identified factors: on a bound, or implausible ([`Implausible`]: a reduction
+/// factor stiffer than the catalogue or more than ten times softer, an elastic body's stiffness
+/// factor far from its FE model).
 pub(super) fn plausibility(parameters: &[Identified], settings: &Settings) -> Vec<String> {
     let (lo, hi) = (settings.min_factor, settings.max_factor);
     parameters
@@ -121,18 +123,8 @@ pub(super) fn plausibility(parameters: &[Identified], settings: &Settings) -> Ve
                     "{} = {} ended on a bound of the factors [{lo}, {hi}]: the data want a value outside",
                     q.name, q.value
                 ))
-            } else if q.value > PLAUSIBLE_MAX {
-                Some(format!(
-                    "{} = {:.4} > {PLAUSIBLE_MAX}: stiffer than its catalogue data, implausible for a reduction factor (a compliance missing elsewhere in the model, or a data problem)",
-                    q.name, q.value
-                ))
-            } else if q.value < PLAUSIBLE_MIN {
-                Some(format!(
-                    "{} = {:.4} < {PLAUSIBLE_MIN}: more than ten times softer than its catalogue data, implausible (a compliance missing elsewhere in the model, or a data problem)",
-                    q.name, q.value
-                ))
             } else {
-                None
+                Implausible::of(&q.name, q.value).map(|why| why.warning(&q.name, q.value))
             }
         })
         .collect()

@@ -9,7 +9,8 @@ use std::path::{Path, PathBuf};
 /// An identification to run: a machine, measured tests and what to fit.
 ///
 /// Defaults (see [`Settings::default`] and [`MeasuredOptions::default`]): the normal and lateral
-/// guideway factor of every axis ([`Parameter::default_set`]); Levenberg–Marquardt with at most 50
+/// guideway factor of every axis and the stiffness factor of every elastic body
+/// ([`Parameter::default_set`]); Levenberg–Marquardt with at most 50
 /// iterations (Nelder–Mead: 2000); factors bounded to [0.01, 10]; tests simulated in the harmonic
 /// steady state and the result confirmed in the time domain; measured R-Test series evaluated at
 /// a set radius of 2 mm unless their folder's `rtest.toml` says otherwise.
@@ -68,7 +69,8 @@ impl Identification {
     }
 
     /// The parameters to fit, by name (`<axis>.<kind>`, kinds `guideway`, `guideway_normal`,
-    /// `guideway_lateral`, `screw`); default: [`Parameter::default_set`].
+    /// `guideway_lateral`, `screw`; `<body>.stiffness` for an elastic body); default:
+    /// [`Parameter::default_set`].
     pub fn parameters<S: Into<String>>(mut self, names: impl IntoIterator<Item = S>) -> Self {
         self.parameters = Some(names.into_iter().map(Into::into).collect());
         self

@@ -96,7 +96,7 @@ impl IdentConfig {
         if self.parameters.as_ref().is_some_and(|p| p.is_empty()) {
             return Err(bad(
                 "parameters",
-                "[] names no parameter: name at least one, or leave the key out for the default set (normal and lateral guideway factor of every axis)".into(),
+                "[] names no parameter: name at least one, or leave the key out for the default set (normal and lateral guideway factor of every axis, the stiffness factor of every elastic body)".into(),
             ));
         }
         if let Some(v) = self.method {

@@ -39,11 +39,12 @@ mod error;
 pub(crate) mod identifiability;
 pub(crate) mod lm;
 pub mod measured;
+pub mod mismatch;
 pub(crate) mod parameters;
 pub(crate) mod problem;
 pub mod report;
 mod rounds;
-pub(crate) mod settings;
+pub mod settings;
 mod solve;
 pub(crate) mod statics;
 pub mod stiffness;
@@ -157,7 +158,10 @@ pub struct IdentResult {
     /// Candidate additional tests ranked by how much they would shrink the worst standard
     /// error (when [`Settings::design`]).
     pub design: Option<design::Design>,
-    /// Warnings (non-identifiable parameters, bounds, χ², plausibility).
+    /// Static terms or clock offsets that may be absorbing a model error (a failed χ² test with
+    /// significant terms; [`mismatch`]).
+    pub model_mismatch: Option<mismatch::ModelMismatch>,
+    /// Warnings (non-identifiable parameters, bounds, χ², plausibility, model mismatch).
     pub warnings: Vec<String>,
     /// Notes (static terms not separable, reversal terms added).
     pub notes: Vec<String>,
@@ -255,6 +259,13 @@ pub fn identify(
         })
         .collect();
     warnings.extend(acceptance::plausibility(&parameters, s));
+    let model_mismatch = mismatch::ModelMismatch::check(
+        fit.uncertainty.chi2_failed,
+        fit.uncertainty.residual_std,
+        problem.statics(),
+        &fit.static_estimates,
+    );
+    warnings.extend(model_mismatch.as_ref().map(|m| m.warning()));
     let mut sims = problem.simulate_many(&[theta0.clone(), theta.clone()])?;
     let simulated_final = sims.pop().unwrap_or_default();
     let simulated_initial = sims.pop().unwrap_or_default();
@@ -299,6 +310,7 @@ pub fn identify(
         statics: problem.statics().clone(),
         static_estimates: fit.static_estimates,
         design,
+        model_mismatch,
         warnings,
         notes,
         refusal,

@@ -92,7 +92,8 @@ impl Parameter {
         })
     }
 
-    /// The default set: normal and lateral guideway factors of every axis.
+    /// The default set: normal and lateral guideway factors of every axis, then the stiffness
+    /// factor of every elastic body (`<body>.stiffness`).
     pub fn default_set(machine: &Machine) -> Vec<Parameter> {
         let mut v = Vec::new();
         for (i, a) in machine.axes().iter().enumerate() {
@@ -103,6 +104,15 @@ impl Parameter {
                 v.push(Parameter {
                     name: format!("{}.{suffix}", a.axis),
                     kind,
+                    index: i,
+                });
+            }
+        }
+        for (i, b) in machine.bodies().iter().enumerate() {
+            if b.elastic().is_some() {
+                v.push(Parameter {
+                    name: format!("{}.stiffness", b.name),
+                    kind: ParameterKind::BodyStiffness,
                     index: i,
                 });
             }

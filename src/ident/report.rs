@@ -192,6 +192,10 @@ pub struct IdentReport {
     /// Hold-out validation (`--validate`).
     #[serde(default)]
     pub validation: Option<ValidationReport>,
+    /// Static terms and clock offsets that may be absorbing a model error (a failed χ² test
+    /// with significant terms; [`super::mismatch`]); null when none.
+    #[serde(default)]
+    pub model_mismatch: Option<super::mismatch::ModelMismatch>,
     /// Clock offsets between scales and R-Test estimated by the evaluation (applied with the
     /// setting `fit_time_offset`).
     #[serde(default)]
@@ -227,9 +231,27 @@ pub struct ParameterReport {
     /// Whether it ended on a bound of the factors.
     #[serde(default)]
     pub at_bound: Option<bool>,
+    /// `[low, high]`: the identified value ± [`super::settings::INTERVAL_SIGMAS`] standard
+    /// errors, taken in θ = 1/p and mapped to p (asymmetric; `high` null: unbounded above;
+    /// [`super::verdict::factor_interval`]); null when not identifiable.
+    #[serde(default)]
+    pub interval_3sigma: Option<(f64, Option<f64>)>,
 }
 
 impl ParameterReport {
+    /// The 3σ interval: as written, else (older reports) from the value and standard error.
+    pub fn interval(&self) -> Option<(f64, Option<f64>)> {
+        self.interval_3sigma.or_else(|| {
+            self.std_err.and_then(|se| {
+                super::verdict::factor_interval(
+                    self.identified,
+                    se,
+                    super::settings::INTERVAL_SIGMAS,
+                )
+            })
+        })
+    }
+
     /// How well the tests determine it ([`Standing`]); without a standard error it is not
     /// identifiable whatever its `identifiable` key says (see also
     /// [`IdentReport::standing`]).
@@ -410,6 +432,13 @@ impl IdentReport {
                     std_err: p.std_err,
                     identifiable: Some(p.identifiable),
                     at_bound: Some(p.at_bound),
+                    interval_3sigma: p.std_err.and_then(|se| {
+                        super::verdict::factor_interval(
+                            p.value,
+                            se,
+                            super::settings::INTERVAL_SIGMAS,
+                        )
+                    }),
                 })
                 .collect(),
             correlation: (0..n)
@@ -450,6 +479,7 @@ impl IdentReport {
             static_terms: static_groups(result),
             experiment_design: result.design.as_ref().map(Into::into),
             validation: None,
+            model_mismatch: result.model_mismatch.clone(),
             clocks: Vec::new(),
             clock_offsets: fitted_clocks(result),
             settings: Some(problem.settings().into()),

@@ -153,6 +153,16 @@ pub(crate) const PLAUSIBLE_MIN: f64 = 0.1;
 /// A reduction factor above this makes the part stiffer than its catalogue data (a warning).
 pub(crate) const PLAUSIBLE_MAX: f64 = 1.0;
 
+/// An elastic body's stiffness factor (`<body>.stiffness`) outside [this,
+/// [`BODY_PLAUSIBLE_MAX`]] is far from its FE model: a factor on Young's modulus of a cast or
+/// welded part is known to some ten per cent, so a factor of 2 says the FE model (sections,
+/// mesh, material) or the joints that hold the body (bolted flanges, feet) are wrong, rather than
+/// the material (a warning).
+pub const BODY_PLAUSIBLE_MIN: f64 = 0.5;
+
+/// See [`BODY_PLAUSIBLE_MIN`].
+pub const BODY_PLAUSIBLE_MAX: f64 = 2.0;
+
 /// Singular values of the weighted Jacobian below this fraction of the largest mark a
 /// parameter combination the tests hardly separate (a warning).
 pub(crate) const NEAR_SINGULAR: f64 = 1e-8;
@@ -168,6 +178,14 @@ pub(crate) const DETERMINED_REL_STD_ERR: f64 = 0.1;
 /// The χ² test fails (a warning) when s² exceeds 1 by more than this many of its standard
 /// deviations √(2/(m − n)).
 pub(crate) const CHI2_SIGMAS: f64 = 4.0;
+
+/// The interval of an identified factor is its value ± this many standard errors, taken in the
+/// compliance θ = 1/p and mapped to p ([`super::verdict::factor_interval`]).
+pub const INTERVAL_SIGMAS: f64 = 3.0;
+
+/// With a failed χ² test, a static term or clock offset beyond this many standard errors says
+/// that it may be absorbing a model error ([`super::mismatch`]).
+pub const MISMATCH_SIGMAS: f64 = 3.0;
 
 /// Harmonic and time-domain EIJ of the final model must agree within this fraction of the
 /// value …

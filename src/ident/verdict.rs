@@ -19,8 +19,8 @@
 //! scaled by s, do not cover that model error).
 
 use super::settings::{
-    CHI2_SIGMAS, DETERMINED_REL_STD_ERR, NOT_IDENTIFIABLE_REL_STD_ERR, PLAUSIBLE_MAX,
-    PLAUSIBLE_MIN, WEAK_REL_STD_ERR,
+    BODY_PLAUSIBLE_MAX, BODY_PLAUSIBLE_MIN, CHI2_SIGMAS, DETERMINED_REL_STD_ERR,
+    NOT_IDENTIFIABLE_REL_STD_ERR, PLAUSIBLE_MAX, PLAUSIBLE_MIN, WEAK_REL_STD_ERR,
 };
 
 /// How well the tests determine one parameter (see the module docs for the rules).
@@ -119,10 +119,105 @@ impl Standing {
     }
 }
 
-/// Whether an identified reduction factor is implausible: stiffer than its catalogue data
-/// (above [`PLAUSIBLE_MAX`]) or more than ten times softer (below [`PLAUSIBLE_MIN`]).
-pub fn implausible(value: f64) -> bool {
-    !(PLAUSIBLE_MIN..=PLAUSIBLE_MAX).contains(&value)
+/// Why an identified factor is implausible. A reduction factor on catalogue data
+/// (`<axis>.guideway…`, `<axis>.screw`) is plausible in [[`PLAUSIBLE_MIN`], [`PLAUSIBLE_MAX`]];
+/// an elastic body's stiffness factor (`<body>.stiffness`) in [[`BODY_PLAUSIBLE_MIN`],
+/// [`BODY_PLAUSIBLE_MAX`]] around its FE model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Implausible {
+    /// A reduction factor above [`PLAUSIBLE_MAX`]: stiffer than the catalogue.
+    StifferThanCatalogue,
+    /// A reduction factor below [`PLAUSIBLE_MIN`]: more than ten times softer.
+    FarSofterThanCatalogue,
+    /// A body stiffness factor below [`BODY_PLAUSIBLE_MIN`]: far softer than its FE model.
+    SofterThanFeModel,
+    /// A body stiffness factor above [`BODY_PLAUSIBLE_MAX`]: far stiffer than its FE model.
+    StifferThanFeModel,
+}
+
+impl Implausible {
+    /// Whether the factor `value` of parameter `name` is implausible, and why; the kind of
+    /// factor follows from the name (`<body>.stiffness` is an elastic body's).
+    pub fn of(name: &str, value: f64) -> Option<Implausible> {
+        if name.ends_with(".stiffness") {
+            if value < BODY_PLAUSIBLE_MIN {
+                Some(Implausible::SofterThanFeModel)
+            } else if value > BODY_PLAUSIBLE_MAX {
+                Some(Implausible::StifferThanFeModel)
+            } else {
+                None
+            }
+        } else if value > PLAUSIBLE_MAX {
+            Some(Implausible::StifferThanCatalogue)
+        } else if value < PLAUSIBLE_MIN {
+            Some(Implausible::FarSofterThanCatalogue)
+        } else {
+            None
+        }
+    }
+
+    /// A short remark for tables, e.g. `stiffer than the catalogue`.
+    pub fn remark(self) -> &'static str {
+        match self {
+            Implausible::StifferThanCatalogue => "stiffer than the catalogue",
+            Implausible::FarSofterThanCatalogue => "more than ten times softer than the catalogue",
+            Implausible::SofterThanFeModel => {
+                "more than twice as soft as its FE model: the FE model or its joints are wrong"
+            }
+            Implausible::StifferThanFeModel => {
+                "more than twice as stiff as its FE model: the FE model or its joints are wrong"
+            }
+        }
+    }
+
+    /// The warning for parameter `name` identified as `value`.
+    pub fn warning(self, name: &str, value: f64) -> String {
+        match self {
+            Implausible::StifferThanCatalogue => format!(
+                "{name} = {value:.4} > {PLAUSIBLE_MAX}: stiffer than its catalogue data, implausible for a reduction factor (a compliance missing elsewhere in the model, or a data problem)"
+            ),
+            Implausible::FarSofterThanCatalogue => format!(
+                "{name} = {value:.4} < {PLAUSIBLE_MIN}: more than ten times softer than its catalogue data, implausible (a compliance missing elsewhere in the model, or a data problem)"
+            ),
+            Implausible::SofterThanFeModel => format!(
+                "{name} = {value:.4} < {BODY_PLAUSIBLE_MIN}: the body is more than twice as soft as its FE model, far beyond what its material allows: the FE model (sections, mesh, material) or the joints that hold the body (bolted flanges, feet, attachments) are likely wrong, or a compliance is missing elsewhere in the model"
+            ),
+            Implausible::StifferThanFeModel => format!(
+                "{name} = {value:.4} > {BODY_PLAUSIBLE_MAX}: the body is more than twice as stiff as its FE model, far beyond what its material allows: the FE model (sections, mesh, material) or the joints that hold the body are likely wrong, or the other compliances of the model are too large"
+            ),
+        }
+    }
+}
+
+/// Whether the identified factor `value` of parameter `name` is implausible ([`Implausible`]).
+pub fn implausible(name: &str, value: f64) -> bool {
+    Implausible::of(name, value).is_some()
+}
+
+/// The interval p ∈ [low, high] of a factor identified as `value` ± `std_err`, `k` standard
+/// errors wide, taken where the fit is linear — in the compliance θ = 1/p, σ_θ = σ_p·θ²
+/// (the delta method the standard error came from) — and mapped back:
+/// low = 1/(θ + k·σ_θ), high = 1/(θ − k·σ_θ). Asymmetric: a loosely determined factor of
+/// 0.5 ± 0.1 (σ_θ = 0.4) spans [0.31, 1.25] at 3σ, not 0.5 ± 0.3. `high` is `None` (unbounded)
+/// when θ − k·σ_θ ≤ 0: the data cannot exclude an element that does not yield at all. `None`
+/// for a value that is not positive or a standard error that is not finite.
+pub fn factor_interval(value: f64, std_err: f64, k: f64) -> Option<(f64, Option<f64>)> {
+    if !(value > 0.0 && std_err.is_finite() && std_err >= 0.0) {
+        return None;
+    }
+    let theta = 1.0 / value;
+    let sigma_theta = std_err * theta * theta;
+    let low = 1.0 / (theta + k * sigma_theta);
+    let upper = theta - k * sigma_theta;
+    Some((low, (upper > 0.0).then(|| 1.0 / upper)))
+}
+
+/// `[0.316, 0.529]` or `[0.316, ∞)`.
+pub fn format_interval(interval: (f64, Option<f64>)) -> String {
+    match interval.1 {
+        Some(high) => format!("[{:.4}, {:.4}]", interval.0, high),
+        None => format!("[{:.4}, ∞)", interval.0),
+    }
 }
 
 /// The χ² test of a fit.

@@ -24,6 +24,7 @@
 
 pub mod conditions;
 pub(crate) mod error;
+pub mod history;
 pub mod inputs;
 pub mod json;
 pub(crate) mod layout;

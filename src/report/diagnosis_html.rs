@@ -11,6 +11,7 @@ use std::fmt::Write as _;
 use super::page::escape;
 use crate::rtest::diagnosis::tolerance::Verdict;
 use crate::rtest::diagnosis::{CircleDiagnosis, Figure, Source, SourceDiagnosis, Term};
+use crate::text::unit_symbol;
 
 /// CSS class of a passed test or term.
 pub(crate) const PASS: &str = "v-pass";
@@ -56,7 +57,7 @@ pub(crate) fn failed_checks(v: &Verdict) -> Vec<String> {
                 c.source.name(),
                 c.value,
                 super::short(c.limit, 4),
-                unit(c.unit)
+                unit_symbol(c.unit)
             )
         })
         .collect()
@@ -68,15 +69,6 @@ fn source_head(s: Source) -> &'static str {
         Source::Internal => "axes<br><small>internal</small>",
         Source::Structure => "structure<br><small>external − internal</small>",
         Source::Tcp => "TCP<br><small>as a ballbar sees it</small>",
-    }
-}
-
-/// A unit as written on the page (`um` → µm).
-fn unit(u: &str) -> &str {
-    match u {
-        "um" => "µm",
-        "um_per_m" => "µm/m",
-        other => other,
     }
 }
 
@@ -100,6 +92,16 @@ fn rows(d: &CircleDiagnosis) -> Vec<(String, Figure, f64)> {
     rows
 }
 
+/// `value ± std_err` with the standard error to two significant digits (1 to 6 decimals).
+pub(crate) fn value_se(value: f64, std_err: f64) -> String {
+    let d = if std_err.is_finite() && std_err > 0.0 {
+        (1.0 - std_err.log10().floor()).clamp(1.0, 6.0) as usize
+    } else {
+        3
+    };
+    format!("{value:.d$} ± {std_err:.d$}")
+}
+
 /// One cell: value ± standard error, its share of G (or of the out-of-plane range) and the
 /// values at the reversal points, coloured by its verdict; grey where within its noise.
 fn cell(t: Option<&Term>) -> String {
@@ -118,10 +120,9 @@ fn cell(t: Option<&Term>) -> String {
         Figure::OutOfPlane => "p–v",
     };
     let mut h = format!(
-        "<td class=\"{}\">{:.3} ± {:.3}<br><small>{share} {:.2}",
+        "<td class=\"{}\">{}<br><small>{share} {:.2}",
         class.trim(),
-        t.value,
-        t.std_err,
+        value_se(t.value, t.std_err),
         t.contribution_um
     );
     if let Some(l) = t.limit {
@@ -208,7 +209,7 @@ pub(crate) fn breakdown_html(
             h,
             "<tr><th class=\"l\">{}</th><td class=\"l\">{}</td>",
             escape(&name),
-            unit(unit_of)
+            unit_symbol(unit_of)
         );
         for s in &d.sources {
             h.push_str(&cell(s.term(&name)));

@@ -42,6 +42,8 @@ pub struct ReportRequest {
     pub moves: Vec<PathBuf>,
     /// Further figures, e.g. EIJ maps.
     pub extra_figures: Vec<Figure>,
+    /// Dated runs of one machine for the history (folders or evaluate JSON files).
+    pub history: Vec<PathBuf>,
     /// The report folder (created if missing; an existing file there is refused).
     pub out_dir: PathBuf,
 }
@@ -91,7 +93,7 @@ fn check_out_dir(req: &ReportRequest) -> Result<(), ReportError> {
     }
     // Never write the report into a folder of measured inputs.
     if let Ok(o) = out.canonicalize() {
-        if req.measured.iter().any(|m| {
+        if req.measured.iter().chain(&req.history).any(|m| {
             m.is_dir()
                 && m.canonicalize()
                     .is_ok_and(|m| o.starts_with(&m) || m.starts_with(&o))
@@ -164,6 +166,12 @@ pub fn generate(req: &ReportRequest) -> Result<PathBuf, ReportError> {
         })
         .collect::<Result<Vec<_>, ReportError>>()?;
 
+    let history = if req.history.is_empty() {
+        None
+    } else {
+        Some(crate::measured::history::history(&req.history)?)
+    };
+
     let mut page = Page::default();
     verdict_section(&mut page, &idents, &suite);
     if let Some(e) = &diagnosis_error {
@@ -218,6 +226,9 @@ pub fn generate(req: &ReportRequest) -> Result<PathBuf, ReportError> {
         for (id, fig) in idents.iter().zip(&ident_figures) {
             ident_html::details(&mut page, id, fig);
         }
+    }
+    if let Some(h) = &history {
+        super::history_html::section(&mut page, h)?;
     }
     if !req.extra_figures.is_empty() {
         page.heading(2, "maps", "EIJ maps over the workspace");

@@ -12,6 +12,7 @@
 //! identify reports ─► verdict (standing, χ², warnings), compare (side by side)
 //! measured::suite::diagnose ─► diagnosis_html (per test and source, beside the circle plot)
 //!                           └► certificate (one A4 page: machine, date, tolerances, pass/fail)
+//! measured::history (dated runs) ─► history_html (terms and EIJ over time, trend plots, drift)
 //! all of it ─► html::generate ─► DIR/report.html (figures inline, page::Page)
 //! ```
 //!
@@ -31,6 +32,7 @@ pub(crate) mod circle;
 pub(crate) mod circle_group;
 pub(crate) mod compare;
 pub(crate) mod diagnosis_html;
+pub(crate) mod history_html;
 pub mod html;
 pub(crate) mod ident_html;
 pub(crate) mod ident_plot;

@@ -90,6 +90,7 @@ ul.notes{font-size:12px;color:#444;margin:2px 0;padding-left:18px}\
 .certificate{border:1px solid #bbb;padding:2px 14px 8px 14px;margin:14px 0}\
 table.cert{font-size:12px}table.cert td,table.cert th{padding:2px 5px}\
 p.cert-verdict{font-size:16px}p.sign{margin-top:18px;font-size:13px}\
+table.history td.trend{padding:0}table.history svg.fig{border:none;width:280px}\
 @page{size:A4;margin:12mm}\
 @media print{body{margin:0;max-width:none;font-size:11px;-webkit-print-color-adjust:exact;print-color-adjust:exact}\
 nav.toc{display:none}h2{margin-top:14px}figure,table,div.diag{break-inside:avoid}h2,h3,h4{break-after:avoid}\

@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use super::page::escape;
 use super::short;
 use crate::ident::report::IdentReport;
-use crate::ident::verdict::{implausible, Standing};
+use crate::ident::verdict::{format_interval, Implausible, Standing};
 
 /// An identify report read for the page, with its letter (`A`, `B`, …) for the comparison.
 #[derive(Debug, Clone)]
@@ -176,7 +176,7 @@ pub(crate) fn warnings_html(warnings: &[String]) -> String {
 pub(crate) fn parameters_html(r: &IdentReport) -> String {
     let mut h = String::from(
         "<table>\n<tr><th class=\"l\">parameter</th><th>initial</th><th>identified</th>\
-         <th>± std err</th><th>σ/value</th><th class=\"l\">standing</th><th class=\"l\">remark</th></tr>\n",
+         <th>± std err</th><th>σ/value</th><th>3σ interval (in 1/p)</th><th class=\"l\">standing</th><th class=\"l\">remark</th></tr>\n",
     );
     let bounds = r.settings.as_ref().map(|s| (s.min_factor, s.max_factor));
     for p in &r.parameters {
@@ -192,16 +192,14 @@ pub(crate) fn parameters_html(r: &IdentReport) -> String {
                 remark.push(format!("bounds [{}, {}]", short(lo, 4), short(hi, 4)));
             }
         }
-        if s != Standing::NotIdentifiable && implausible(p.identified) {
-            remark.push(if p.identified > 1.0 {
-                "implausible: stiffer than the catalogue".into()
-            } else {
-                "implausible: more than ten times softer than the catalogue".into()
-            });
+        if let Some(why) = Implausible::of(&p.name, p.identified) {
+            if s != Standing::NotIdentifiable {
+                remark.push(format!("implausible: {}", why.remark()));
+            }
         }
         let _ = writeln!(
             h,
-            "<tr><td class=\"l\">{}</td><td>{}</td><td>{:.4}</td><td>{}</td><td>{}</td>\
+            "<tr><td class=\"l\">{}</td><td>{}</td><td>{:.4}</td><td>{}</td><td>{}</td><td>{}</td>\
              <td class=\"l {}\">{}</td><td class=\"w\">{}</td></tr>",
             escape(&p.name),
             short(p.initial, 6),
@@ -209,13 +207,19 @@ pub(crate) fn parameters_html(r: &IdentReport) -> String {
             p.std_err.map_or("–".into(), |s| format!("{s:.4}")),
             s.rel_std_err()
                 .map_or("–".into(), |r| format!("{:.1} %", 100.0 * r)),
+            p.interval().map_or("–".into(), format_interval),
             standing_class(s),
             s.label(),
             escape(&remark.join("; "))
         );
     }
     h.push_str("</table>\n");
-    let _ = writeln!(h, "<p class=\"note\">{}.</p>", escape(&Standing::legend()));
+    let _ = writeln!(
+        h,
+        "<p class=\"note\">{}. 3σ interval: the value ± {:.0} standard errors taken in the compliance 1/p, where the fit is linear, and mapped to p (asymmetric; ∞ where the data cannot exclude an element that does not yield).</p>",
+        escape(&Standing::legend()),
+        crate::ident::settings::INTERVAL_SIGMAS
+    );
     h
 }
 

@@ -4,6 +4,8 @@
 #![allow(dead_code)]
 
 pub mod circle_terms;
+pub mod diagnosis_checks;
+pub mod diagnosis_demo;
 pub mod imperfect;
 pub mod mutation;
 pub mod random_machine;
@@ -35,6 +37,22 @@ pub fn machine(name: &str) -> Machine {
 /// The demo machine.
 pub fn demo() -> Machine {
     machine("demo-vmc.toml")
+}
+
+/// The demo machine's default parameters (guideway factors) identified from `tests`, without
+/// the ranking of candidate tests: the problem and its result.
+pub fn fit_demo(
+    tests: Vec<eij::ident::TestCase>,
+) -> (eij::ident::Problem, eij::ident::IdentResult) {
+    let base = demo();
+    let settings = eij::ident::Settings {
+        design: false,
+        ..Default::default()
+    };
+    let params = eij::ident::Parameter::default_set(&base);
+    let problem = eij::ident::Problem::new(base, params, tests, settings).unwrap();
+    let result = eij::ident::identify(&problem, None).unwrap();
+    (problem, result)
 }
 
 /// The demo machine file's text (for variations of it).
