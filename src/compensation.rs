@@ -26,10 +26,10 @@ use std::path::Path;
 /// Grid points per axis over its stroke (5: the ends, the middle and the quarters).
 pub const DEFAULT_POINTS: usize = 5;
 /// At most this many points per axis.
-pub const MAX_POINTS_PER_AXIS: usize = 21;
+pub(crate) const MAX_POINTS_PER_AXIS: usize = 21;
 /// A linear form in the best axis is kept only where it lowers the worst residual of the constant
 /// by at least this fraction; otherwise the coefficient is constant (`none`).
-pub const MIN_IMPROVEMENT: f64 = 0.2;
+pub(crate) const MIN_IMPROVEMENT: f64 = 0.2;
 /// Step of the central differences that give the correction's velocity and acceleration, s.
 pub const DIFF_STEP_S: f64 = 2.5e-4;
 

@@ -88,6 +88,8 @@
 //!
 //! `cargo build --lib --no-default-features` builds the bare library.
 
+#![warn(unreachable_pub)]
+
 pub mod axes;
 pub mod compensation;
 pub mod control;

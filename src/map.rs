@@ -47,7 +47,7 @@ impl From<PredictError> for MapError {
 
 /// Most grid points of one map (all grids multiplied): bounds time and memory; a compensation
 /// table of 21 × 21 × 21 positions has 9 261.
-pub const MAX_POINTS: usize = 100_000;
+pub(crate) const MAX_POINTS: usize = 100_000;
 
 /// Grid values of one axis: `min:max:count` in mm (count ≥ 1; count 1 takes `min`).
 #[derive(Debug, Clone, PartialEq)]

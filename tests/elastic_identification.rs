@@ -85,18 +85,7 @@ fn measured(truth: &Machine, circles: Vec<CircleTest>) -> Vec<TestCase> {
         .map(|(circle, sim)| TestCase {
             source: format!("synthetic {}", circle.label()),
             circle,
-            measured: sim
-                .into_iter()
-                .map(|(k, value)| {
-                    (
-                        k,
-                        eij::axes::Estimate {
-                            value,
-                            std_err: 0.01,
-                        },
-                    )
-                })
-                .collect(),
+            measured: eij::EijEstimates::with_std_err(sim, 0.01),
             clock: None,
         })
         .collect()

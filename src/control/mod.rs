@@ -23,7 +23,7 @@ use crate::mbs::{modal, MbsError, Model};
 use nalgebra::{Complex, DMatrix, DVector};
 use std::sync::atomic::{AtomicBool, Ordering};
 
-pub mod frequency;
+pub(crate) mod frequency;
 pub mod stability;
 pub use frequency::FrequencyForm;
 pub use stability::NearbyCertificate;
@@ -78,7 +78,7 @@ pub enum ControlError {
 }
 
 /// Input channel kinds per axis, in order.
-pub const INPUTS_PER_AXIS: usize = 3;
+pub(crate) const INPUTS_PER_AXIS: usize = 3;
 
 /// The closed loop at one axis position.
 #[derive(Debug, Clone)]

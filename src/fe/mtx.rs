@@ -16,7 +16,7 @@ use std::io::{BufRead, BufReader, Write};
 use std::path::Path;
 
 /// Most bytes of one matrix file: about 40 million entries.
-pub const MAX_MATRIX_BYTES: u64 = 2 << 30;
+pub(crate) const MAX_MATRIX_BYTES: u64 = 2 << 30;
 
 #[derive(Clone, Copy)]
 struct Entry {

@@ -205,13 +205,13 @@ fn read_toml<T: serde::de::DeserializeOwned>(path: &Path) -> Result<(String, T),
 }
 
 /// Most optimiser iterations a config may ask for.
-pub const MAX_ITERS: f64 = 1e6;
+pub(crate) const MAX_ITERS: f64 = 1e6;
 /// Most steady revolutions per simulated test.
 pub const MAX_REVOLUTIONS: f64 = 1000.0;
 /// Highest output rate of the simulated tests, Hz.
-pub const MAX_RATE_HZ: f64 = 1e6;
+pub(crate) const MAX_RATE_HZ: f64 = 1e6;
 /// Largest bound of a reduction factor.
-pub const MAX_FACTOR: f64 = 1000.0;
+pub(crate) const MAX_FACTOR: f64 = 1000.0;
 
 /// An expected identified value with its tolerance.
 #[derive(Debug, Clone, PartialEq, Deserialize)]

@@ -28,7 +28,7 @@ use nalgebra::{DMatrix, DVector};
 pub const KEEP: usize = 10;
 
 /// Fractions of every stroke at which candidate circle centres lie.
-pub const STROKE_FRACTIONS: [f64; 3] = [0.1, 0.5, 0.9];
+pub(crate) const STROKE_FRACTIONS: [f64; 3] = [0.1, 0.5, 0.9];
 
 /// One candidate test and what it would give.
 #[derive(Debug, Clone, PartialEq)]

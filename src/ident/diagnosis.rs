@@ -77,7 +77,7 @@ pub struct StaticGroupReport {
 }
 
 /// The static terms of `result` per group.
-pub fn static_groups(result: &IdentResult) -> Vec<StaticGroupReport> {
+pub(crate) fn static_groups(result: &IdentResult) -> Vec<StaticGroupReport> {
     result
         .statics
         .groups

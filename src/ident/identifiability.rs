@@ -88,7 +88,7 @@ impl NotIdentifiable {
 
 /// The result of the analysis.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Analysis {
+pub(crate) struct Analysis {
     /// Parameters the tests determine (indices, ascending).
     pub free: Vec<usize>,
     /// Those they do not, in the order found.
@@ -139,7 +139,7 @@ fn scaled(js: &DMatrix<f64>, set: &[usize]) -> Option<Scaled> {
 }
 
 /// Analyses the Jacobian `j` (m × n) of the residuals at `theta` (θ = 1/p).
-pub fn analyse(j: &DMatrix<f64>, theta: &DVector<f64>) -> Analysis {
+pub(crate) fn analyse(j: &DMatrix<f64>, theta: &DVector<f64>) -> Analysis {
     let n = theta.len();
     let norms: Vec<f64> = (0..n).map(|i| j.column(i).norm()).collect();
     let max_norm = norms.iter().cloned().fold(0.0, f64::max);

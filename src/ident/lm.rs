@@ -18,11 +18,11 @@ use argmin::core::{
 use nalgebra::{DMatrix, DVector};
 
 /// The state type used by [`LevenbergMarquardt`].
-pub type LmState = IterState<DVector<f64>, (), DMatrix<f64>, (), DVector<f64>, f64>;
+pub(crate) type LmState = IterState<DVector<f64>, (), DMatrix<f64>, (), DVector<f64>, f64>;
 
 /// Levenberg–Marquardt with bounds.
 #[derive(Debug, Clone)]
-pub struct LevenbergMarquardt {
+pub(crate) struct LevenbergMarquardt {
     lambda: f64,
     lower: DVector<f64>,
     upper: DVector<f64>,
@@ -35,7 +35,12 @@ pub struct LevenbergMarquardt {
 impl LevenbergMarquardt {
     /// A solver with bounds `lower ≤ θ ≤ upper`, relative cost tolerance and step tolerance;
     /// no noise tolerance (see [`LevenbergMarquardt::with_noise_tolerance`]).
-    pub fn new(lower: DVector<f64>, upper: DVector<f64>, tol_cost: f64, tol_step: f64) -> Self {
+    pub(crate) fn new(
+        lower: DVector<f64>,
+        upper: DVector<f64>,
+        tol_cost: f64,
+        tol_step: f64,
+    ) -> Self {
         LevenbergMarquardt {
             lambda: 1e-3,
             lower,
@@ -49,7 +54,7 @@ impl LevenbergMarquardt {
 
     /// Also converged when the Gauss–Newton step left is below `standard_errors` standard
     /// errors (see the module docs).
-    pub fn with_noise_tolerance(mut self, standard_errors: f64) -> Self {
+    pub(crate) fn with_noise_tolerance(mut self, standard_errors: f64) -> Self {
         self.tol_noise = standard_errors;
         self
     }

@@ -46,7 +46,7 @@ impl Provenance {
 }
 
 /// The latest SOURCE_DATE_EPOCH written: 9999-12-31T23:59:59Z (RFC 3339 has four-digit years).
-pub const MAX_SOURCE_DATE_EPOCH: u64 = 253_402_300_799;
+pub(crate) const MAX_SOURCE_DATE_EPOCH: u64 = 253_402_300_799;
 
 /// SOURCE_DATE_EPOCH is set but is not a time stamp eij can write.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -125,33 +125,33 @@ impl Default for MeasuredOptions {
 /// rounding only (the harmonic simulation resolves ~1e-13 relative; a reduction factor that a test
 /// sees moves its EIJ by far more over a finite-difference step): their difference counts as
 /// zero in the Jacobian.
-pub const SIMULATION_RESOLUTION: f64 = 1e-10;
+pub(crate) const SIMULATION_RESOLUTION: f64 = 1e-10;
 
 /// A parameter whose Jacobian column norm at the start is below this fraction of the largest
 /// is not seen by the tests: it is kept at its start value and reported not identifiable.
-pub const UNIDENTIFIABLE_COLUMN: f64 = 1e-6;
+pub(crate) const UNIDENTIFIABLE_COLUMN: f64 = 1e-6;
 
 /// A parameter whose standard error predicted at the start (σ taken at face value) exceeds
 /// this fraction of its value is not determined by the tests: kept at its start value.
-pub const NOT_IDENTIFIABLE_REL_STD_ERR: f64 = 1.0;
+pub(crate) const NOT_IDENTIFIABLE_REL_STD_ERR: f64 = 1.0;
 
 /// Singular values of the column-scaled Jacobian below this fraction of the largest are a
 /// combination the tests do not see at all (central differences resolve ~1e-6 of a column).
-pub const DEGENERATE_SINGULAR: f64 = 1e-6;
+pub(crate) const DEGENERATE_SINGULAR: f64 = 1e-6;
 
 /// A parameter takes part in a null-space direction when its share of the singular vector is
 /// at least this fraction of the largest share.
-pub const TIE_SHARE: f64 = 0.2;
+pub(crate) const TIE_SHARE: f64 = 0.2;
 
 /// A factor within this fraction of a bound has ended on it (0.010006 against 0.01 has).
-pub const AT_BOUND_REL: f64 = 1e-3;
+pub(crate) const AT_BOUND_REL: f64 = 1e-3;
 
 /// Identified factors outside [this, [`PLAUSIBLE_MAX`]] are implausible for a reduction of
 /// catalogue stiffness (a warning).
-pub const PLAUSIBLE_MIN: f64 = 0.1;
+pub(crate) const PLAUSIBLE_MIN: f64 = 0.1;
 
 /// A reduction factor above this makes the part stiffer than its catalogue data (a warning).
-pub const PLAUSIBLE_MAX: f64 = 1.0;
+pub(crate) const PLAUSIBLE_MAX: f64 = 1.0;
 
 /// An elastic body's stiffness factor (`<body>.stiffness`) outside [this,
 /// [`BODY_PLAUSIBLE_MAX`]] is far from its FE model: a factor on Young's modulus of a cast or
@@ -165,19 +165,19 @@ pub const BODY_PLAUSIBLE_MAX: f64 = 2.0;
 
 /// Singular values of the weighted Jacobian below this fraction of the largest mark a
 /// parameter combination the tests hardly separate (a warning).
-pub const NEAR_SINGULAR: f64 = 1e-8;
+pub(crate) const NEAR_SINGULAR: f64 = 1e-8;
 
 /// A standard error above this fraction of the value marks a weakly determined parameter
 /// (a warning).
-pub const WEAK_REL_STD_ERR: f64 = 0.5;
+pub(crate) const WEAK_REL_STD_ERR: f64 = 0.5;
 
 /// A standard error up to this fraction of the value marks a determined parameter (above it,
 /// up to [`WEAK_REL_STD_ERR`], a loosely determined one; see [`super::verdict`]).
-pub const DETERMINED_REL_STD_ERR: f64 = 0.1;
+pub(crate) const DETERMINED_REL_STD_ERR: f64 = 0.1;
 
 /// The χ² test fails (a warning) when s² exceeds 1 by more than this many of its standard
 /// deviations √(2/(m − n)).
-pub const CHI2_SIGMAS: f64 = 4.0;
+pub(crate) const CHI2_SIGMAS: f64 = 4.0;
 
 /// The interval of an identified factor is its value ± this many standard errors, taken in the
 /// compliance θ = 1/p and mapped to p ([`super::verdict::factor_interval`]).
@@ -189,14 +189,14 @@ pub const MISMATCH_SIGMAS: f64 = 3.0;
 
 /// Harmonic and time-domain EIJ of the final model must agree within this fraction of the
 /// value …
-pub const CONFIRM_REL: f64 = 0.01;
+pub(crate) const CONFIRM_REL: f64 = 0.01;
 
 /// … or within this many µm·s²/m, whichever is larger (else a warning).
-pub const CONFIRM_ABS_UM_S2_PER_M: f64 = 0.01;
+pub(crate) const CONFIRM_ABS_UM_S2_PER_M: f64 = 0.01;
 
 /// Nelder–Mead's starting simplex: the start and one vertex per parameter with θ scaled by this.
-pub const NELDER_MEAD_SIMPLEX_SCALE: f64 = 1.3;
+pub(crate) const NELDER_MEAD_SIMPLEX_SCALE: f64 = 1.3;
 
 /// Nelder–Mead has converged when the simplex costs spread by less than this fraction of the
 /// starting cost (it has no gradient to test).
-pub const NELDER_MEAD_REL_SPREAD: f64 = 1e-7;
+pub(crate) const NELDER_MEAD_REL_SPREAD: f64 = 1e-7;

@@ -22,7 +22,7 @@ impl ParameterKind {
 
 /// The stiffness table of `machine` with, for every fitted parameter, its name and the standard
 /// error of its factor (`None`: not determined by the tests) on the rows it scales.
-pub fn table_with_std_err<'a>(
+pub(crate) fn table_with_std_err<'a>(
     machine: &Machine,
     fitted: impl IntoIterator<Item = (&'a Parameter, Option<f64>)>,
 ) -> StiffnessTable {

@@ -287,12 +287,12 @@ mod signals {
 
     /// While alive, the signals are noted instead of acted on; dropped, the previous
     /// dispositions return and a noted signal is raised again.
-    pub struct Held {
+    pub(super) struct Held {
         old: Vec<(libc::c_int, libc::sigaction)>,
     }
 
     impl Held {
-        pub fn new() -> Held {
+        pub(super) fn new() -> Held {
             let mut old = Vec::new();
             for sig in HELD {
                 // SAFETY: plain sigaction calls with zero-initialised structs; the handler only

@@ -5,7 +5,7 @@
 
 /// File text as it may appear inside a one-line message: control characters (line ends in a
 /// quoted cell, NUL, …) escaped, and long text cut after 40 characters.
-pub fn quote_cell(text: &str) -> String {
+pub(crate) fn quote_cell(text: &str) -> String {
     const MAX_CHARS: usize = 40;
     let mut out = String::new();
     for (i, c) in text.chars().enumerate() {
@@ -23,7 +23,7 @@ pub fn quote_cell(text: &str) -> String {
 }
 
 /// The lines of a text, without line ends, with their 1-based numbers and byte offsets.
-pub fn lines(bytes: &[u8]) -> impl Iterator<Item = (u64, usize, &[u8])> {
+pub(crate) fn lines(bytes: &[u8]) -> impl Iterator<Item = (u64, usize, &[u8])> {
     let mut start = 0;
     let mut number = 0;
     std::iter::from_fn(move || {
@@ -44,14 +44,14 @@ pub fn lines(bytes: &[u8]) -> impl Iterator<Item = (u64, usize, &[u8])> {
 }
 
 /// Whether a line is blank or a `#` comment.
-pub fn is_comment_or_blank(line: &[u8]) -> bool {
+pub(crate) fn is_comment_or_blank(line: &[u8]) -> bool {
     let trimmed = line.trim_ascii_start();
     trimmed.is_empty() || trimmed[0] == b'#'
 }
 
 /// The separator of a header line: the candidate that splits it into the most cells (`,` on a
 /// tie, and for a line without any).
-pub fn separator_of(line: &[u8]) -> u8 {
+pub(crate) fn separator_of(line: &[u8]) -> u8 {
     let mut best = (0, b',');
     for sep in [b',', b';', b'\t'] {
         let count = line.iter().filter(|&&b| b == sep).count();
@@ -63,7 +63,7 @@ pub fn separator_of(line: &[u8]) -> u8 {
 }
 
 /// The first line that is no comment and not blank (a byte-order mark dropped).
-pub fn header_line(bytes: &[u8]) -> Option<&[u8]> {
+pub(crate) fn header_line(bytes: &[u8]) -> Option<&[u8]> {
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     lines(bytes)
         .map(|(_, _, l)| l)
@@ -71,13 +71,13 @@ pub fn header_line(bytes: &[u8]) -> Option<&[u8]> {
 }
 
 /// The separator of a file's header line (see [`separator_of`]).
-pub fn header_separator(bytes: &[u8]) -> u8 {
+pub(crate) fn header_separator(bytes: &[u8]) -> u8 {
     header_line(bytes).map_or(b',', separator_of)
 }
 
 /// Physical line numbers (1-based) of byte offsets, counted forward through the file: the CSV
 /// reader's own line count leaves out blank lines.
-pub struct LineCounter<'a> {
+pub(crate) struct LineCounter<'a> {
     bytes: &'a [u8],
     byte: usize,
     line: u64,
@@ -85,12 +85,12 @@ pub struct LineCounter<'a> {
 
 impl<'a> LineCounter<'a> {
     /// A counter at the start of `bytes` (line 1).
-    pub fn new(bytes: &'a [u8]) -> Self {
+    pub(crate) fn new(bytes: &'a [u8]) -> Self {
         Self::starting_at(bytes, 1)
     }
 
     /// A counter at the start of `bytes`, which begin on line `line` of their file.
-    pub fn starting_at(bytes: &'a [u8], line: u64) -> Self {
+    pub(crate) fn starting_at(bytes: &'a [u8], line: u64) -> Self {
         LineCounter {
             bytes,
             byte: 0,
@@ -99,7 +99,7 @@ impl<'a> LineCounter<'a> {
     }
 
     /// The line holding byte `offset`; offsets must not decrease between calls.
-    pub fn line_of(&mut self, offset: u64) -> u64 {
+    pub(crate) fn line_of(&mut self, offset: u64) -> u64 {
         let end = (offset as usize).min(self.bytes.len());
         if end > self.byte {
             let newlines = self.bytes[self.byte..end]
@@ -114,7 +114,7 @@ impl<'a> LineCounter<'a> {
 
     /// The line of a record: of its first byte that is not a line end (the reader's record
     /// position may point at the end of the previous line or at skipped blank lines).
-    pub fn line_of_record(&mut self, record: &csv::StringRecord) -> u64 {
+    pub(crate) fn line_of_record(&mut self, record: &csv::StringRecord) -> u64 {
         match record.position() {
             Some(p) => self.line_of_position(p),
             None => self.line,
@@ -122,7 +122,7 @@ impl<'a> LineCounter<'a> {
     }
 
     /// The line of a reader position, skipping line ends as [`Self::line_of_record`] does.
-    pub fn line_of_position(&mut self, p: &csv::Position) -> u64 {
+    pub(crate) fn line_of_position(&mut self, p: &csv::Position) -> u64 {
         let mut start = p.byte() as usize;
         while self
             .bytes
@@ -137,7 +137,7 @@ impl<'a> LineCounter<'a> {
 
 /// What a CSV reader's error says, without its own position (the caller names file and line:
 /// the reader's "CSV error: record 2 (line: 3, byte: 120)" would repeat them).
-pub fn csv_message(e: &csv::Error) -> String {
+pub(crate) fn csv_message(e: &csv::Error) -> String {
     match e.kind() {
         csv::ErrorKind::UnequalLengths {
             expected_len, len, ..
@@ -150,7 +150,7 @@ pub fn csv_message(e: &csv::Error) -> String {
 
 /// Why a cell is not a number eij can use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum BadNumber {
+pub(crate) enum BadNumber {
     /// The text is no number.
     NotANumber,
     /// NaN or infinite.
@@ -159,7 +159,7 @@ pub enum BadNumber {
 
 /// Parses one finite number; with `decimal_comma`, a cell with `,` and no `.` is read with the
 /// comma as decimal point (files whose separator is not `,`).
-pub fn parse_number(text: &str, decimal_comma: bool) -> Result<f64, BadNumber> {
+pub(crate) fn parse_number(text: &str, decimal_comma: bool) -> Result<f64, BadNumber> {
     let parsed = if decimal_comma && text.contains(',') && !text.contains('.') {
         text.replace(',', ".").parse::<f64>()
     } else {

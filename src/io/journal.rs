@@ -234,7 +234,7 @@ pub(super) struct FolderLocks {
 impl FolderLocks {
     /// Locks `folders` (resolved paths), in sorted order so that runs never wait on each other
     /// in a circle.
-    pub fn new(folders: &[PathBuf]) -> FolderLocks {
+    pub(super) fn new(folders: &[PathBuf]) -> FolderLocks {
         let mut sorted: Vec<&PathBuf> = folders.iter().collect();
         sorted.sort();
         sorted.dedup();

@@ -5,9 +5,9 @@
 use std::path::{Path, PathBuf};
 
 mod commit;
-pub mod delimited;
+pub(crate) mod delimited;
 mod journal;
-pub mod read;
+pub(crate) mod read;
 
 pub use commit::{recover, write_set, StreamedOutput};
 pub use read::{read_input, read_input_text, track_inputs, FileId, ReadError};

@@ -9,11 +9,11 @@ use std::sync::Mutex;
 
 /// Most bytes of one measured series (R-Test CSV, split recording, move CSV): about 8 million
 /// rows of seven numbers with ten digits each.
-pub const MAX_SERIES_BYTES: u64 = 512 << 20;
+pub(crate) const MAX_SERIES_BYTES: u64 = 512 << 20;
 
 /// Most bytes of one description file (machine, catalogue, `rtest.toml`, config, EIJ table,
 /// map, compensation table, report JSON).
-pub const MAX_TEXT_BYTES: u64 = 64 << 20;
+pub(crate) const MAX_TEXT_BYTES: u64 = 64 << 20;
 
 /// Why an input could not be read.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -80,12 +80,12 @@ pub fn track_inputs() {
 }
 
 /// The files read so far (while [`track_inputs`] is on), with the path they were read by.
-pub fn inputs_read() -> Vec<(FileId, PathBuf)> {
+pub(crate) fn inputs_read() -> Vec<(FileId, PathBuf)> {
     READ.lock().map(|r| r.clone()).unwrap_or_default()
 }
 
 /// Remembers `path` as an input of the run (while [`track_inputs`] is on).
-pub fn record_input(path: &Path) {
+pub(crate) fn record_input(path: &Path) {
     if !TRACKING.load(Ordering::SeqCst) {
         return;
     }
@@ -113,7 +113,7 @@ pub fn read_input(path: &Path, max_bytes: u64) -> Result<Vec<u8>, ReadError> {
 /// A text whose lines end in CR alone (classic Mac OS exports) with LF line ends instead, so
 /// that it is read line by line rather than as one line; other texts as they are (CR LF is
 /// read as a line end everywhere).
-pub fn unix_line_ends(mut bytes: Vec<u8>) -> Vec<u8> {
+pub(crate) fn unix_line_ends(mut bytes: Vec<u8>) -> Vec<u8> {
     if bytes.contains(&b'\r') && !bytes.contains(&b'\n') {
         for b in &mut bytes {
             if *b == b'\r' {
@@ -138,7 +138,10 @@ pub fn read_input_text(path: &Path, max_bytes: u64) -> Result<String, ReadError>
 /// are parsed line by line rather than held whole): the same checks and recording as
 /// [`read_input`]; the reader stops after `max_bytes + 1` bytes, so a caller that reads more
 /// than `max_bytes` knows the input is too large.
-pub fn open_input(path: &Path, max_bytes: u64) -> Result<std::io::Take<std::fs::File>, ReadError> {
+pub(crate) fn open_input(
+    path: &Path,
+    max_bytes: u64,
+) -> Result<std::io::Take<std::fs::File>, ReadError> {
     let meta = std::fs::metadata(path).map_err(|e| match e.kind() {
         std::io::ErrorKind::NotFound => ReadError::NotFound,
         _ => ReadError::Io(e.to_string()),

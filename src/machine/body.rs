@@ -259,7 +259,7 @@ pub struct Body {
 }
 
 /// Names of the six rigid coordinates.
-pub const RIGID_COORDINATES: [&str; 6] = ["x", "y", "z", "a", "b", "c"];
+pub(crate) const RIGID_COORDINATES: [&str; 6] = ["x", "y", "z", "a", "b", "c"];
 
 impl Body {
     /// Fixed to the ground (no coordinates).
@@ -364,7 +364,7 @@ impl Body {
 
 /// [[I, −skew(p − c)], [0, I]]: translation and rotation of point p of a rigid body with its
 /// coordinates at c.
-pub fn rigid_point_motion(p: &Vector3<f64>, c: &Vector3<f64>) -> DMatrix<f64> {
+pub(crate) fn rigid_point_motion(p: &Vector3<f64>, c: &Vector3<f64>) -> DMatrix<f64> {
     let r = p - c;
     let mut t = DMatrix::zeros(6, 6);
     t.view_mut((0, 0), (3, 3)).fill_with_identity();

@@ -5,7 +5,7 @@ use super::MachineError;
 use std::collections::BTreeMap;
 
 /// The catalogue bundled with eij (`machines/catalogue/carriages.toml`).
-pub const BUNDLED: &str = include_str!("../../machines/catalogue/carriages.toml");
+pub(crate) const BUNDLED: &str = include_str!("../../machines/catalogue/carriages.toml");
 
 /// Stiffness data of one carriage type.
 #[derive(Debug, Clone, PartialEq)]

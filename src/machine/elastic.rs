@@ -29,7 +29,7 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, OnceLock};
 
 /// Default number of fixed-interface modes where neither `modes` nor `cutoff_hz` is given.
-pub const DEFAULT_MODES: usize = 20;
+pub(crate) const DEFAULT_MODES: usize = 20;
 
 /// How far given mass properties may differ from the FE model's (CONTRACT): mass and inertia
 /// relative, COG relative to the body's extent.

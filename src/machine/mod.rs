@@ -6,7 +6,7 @@
 //! Errors name the file and the key path (`axis[x].guideway.reduction_normal`).
 
 mod attach;
-pub mod body;
+pub(crate) mod body;
 pub mod catalogue;
 pub mod elastic;
 mod pose;

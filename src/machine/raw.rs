@@ -352,7 +352,7 @@ pub struct RawJoint {
 /// A carriage catalogue file.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct RawCatalogue {
+pub(crate) struct RawCatalogue {
     /// Entries.
     #[serde(rename = "carriage")]
     pub carriages: Vec<RawCarriage>,
@@ -361,7 +361,7 @@ pub struct RawCatalogue {
 /// A catalogue entry.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct RawCarriage {
+pub(crate) struct RawCarriage {
     /// Id used in machine files.
     pub id: String,
     /// Compressive (radial) stiffness, N/µm.

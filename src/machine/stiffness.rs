@@ -179,7 +179,7 @@ pub struct StiffnessTable {
 }
 
 /// The columns every table has (CONTRACT.md).
-pub const COLUMNS: [&str; 7] = [
+pub(crate) const COLUMNS: [&str; 7] = [
     "axis",
     "element",
     "direction",
@@ -190,7 +190,7 @@ pub const COLUMNS: [&str; 7] = [
 ];
 
 /// The columns an identified table adds.
-pub const IDENTIFIED_COLUMNS: [&str; 2] = ["std_err_n_per_um", "parameter"];
+pub(crate) const IDENTIFIED_COLUMNS: [&str; 2] = ["std_err_n_per_um", "parameter"];
 
 /// Shaft stiffness with the nut at l₁ from the fixed bearing, N/m (without the factor).
 fn shaft_n_per_m(d: &Drive, l1: f64) -> f64 {

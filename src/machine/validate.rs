@@ -12,13 +12,13 @@ use crate::axes::Axis;
 use nalgebra::{Matrix3, Vector3};
 
 /// Most bodies of a machine (each adds six degrees of freedom).
-pub const MAX_BODIES: usize = 100;
+pub(super) const MAX_BODIES: usize = 100;
 /// Most joints between bodies.
-pub const MAX_JOINTS: usize = 1000;
+pub(super) const MAX_JOINTS: usize = 1000;
 /// Most carriages over all guideways.
-pub const MAX_CARRIAGES: usize = 1000;
+pub(super) const MAX_CARRIAGES: usize = 1000;
 /// Most extra catalogue files.
-pub const MAX_CATALOGUES: usize = 16;
+pub(super) const MAX_CATALOGUES: usize = 16;
 
 /// How far a given `workpiece.point_m` may lie from the TCP at the reference position, m.
 const NEST_TOLERANCE_M: f64 = 1e-6;

@@ -15,10 +15,10 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// The file of a folder that states the conditions of the R-Test files in it.
-pub const CONDITIONS_FILE: &str = "rtest.toml";
+pub(crate) const CONDITIONS_FILE: &str = "rtest.toml";
 
 /// Most tests one command reads (files named, found in folders and in `[[test]]` tables).
-pub const MAX_TESTS: usize = 10_000;
+pub(crate) const MAX_TESTS: usize = 10_000;
 
 /// Conditions of the circle tests of one folder (`rtest.toml`); absent keys are unknown.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -129,7 +129,7 @@ impl Session {
 
 /// Seconds since 1970-01-01T00:00:00Z of an ISO 8601 date or date-time (RFC 3339, the offset
 /// optional: UTC).
-pub fn epoch_s(date: &str) -> Result<f64, String> {
+pub(crate) fn epoch_s(date: &str) -> Result<f64, String> {
     let full = if date.len() == 10 {
         format!("{date}T00:00:00Z")
     } else if date.ends_with('Z') {
@@ -488,7 +488,7 @@ fn test_entry(
 }
 
 /// The folder of a file (`.` for a bare file name).
-pub fn folder_of(file: &Path) -> PathBuf {
+pub(crate) fn folder_of(file: &Path) -> PathBuf {
     match file.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),

@@ -11,7 +11,7 @@ use serde_json::Value;
 use std::collections::BTreeMap;
 
 /// EIJ (or their standard errors) keyed by name (`EZZ`, …), µm·s²/m.
-pub type EijByName = BTreeMap<String, f64>;
+pub(crate) type EijByName = BTreeMap<String, f64>;
 
 fn by_name(map: &EijMap) -> EijByName {
     map.iter().map(|(k, v)| (k.name(), *v)).collect()

@@ -121,7 +121,7 @@ pub enum ColumnEntry {
 }
 
 /// The contract columns of an R-Test series with the kind of their unit.
-pub const CONTRACT_COLUMNS: [&str; 7] = [
+pub(crate) const CONTRACT_COLUMNS: [&str; 7] = [
     "t_s", "x_int_mm", "y_int_mm", "z_int_mm", "x_ext_mm", "y_ext_mm", "z_ext_mm",
 ];
 
@@ -244,7 +244,7 @@ impl ColumnMap {
 
 /// The dialect recognised in a file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Dialect {
+pub(crate) struct Dialect {
     /// `,`, `;` or tab.
     pub separator: u8,
     /// Numbers written with a decimal comma (`;` and tab files).
@@ -255,7 +255,7 @@ pub struct Dialect {
 
 impl Dialect {
     /// The separator in words, for messages.
-    pub fn separator_name(&self) -> &'static str {
+    pub(crate) fn separator_name(&self) -> &'static str {
         match self.separator {
             b';' => "';'",
             b'\t' => "tab",
@@ -266,7 +266,7 @@ impl Dialect {
 
 /// Columns read from a file, converted to the contract's units, in the order asked for.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Table {
+pub(crate) struct Table {
     /// Values per wanted column.
     pub columns: Vec<Vec<f64>>,
     /// File line of every row.
@@ -297,7 +297,7 @@ fn split_header(line: &[u8], sep: u8) -> Vec<String> {
 /// Reads the `wanted` contract columns of a delimited text (dialect recognised, names and units
 /// from `map`); other columns are ignored. `name` stands for the file in messages. At least one
 /// data row is not required here; callers check the row count.
-pub fn read_table(
+pub(crate) fn read_table(
     name: &str,
     bytes: &[u8],
     wanted: &[&str],

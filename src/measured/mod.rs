@@ -23,14 +23,14 @@
 //! ```
 
 pub mod conditions;
-pub mod error;
+pub(crate) mod error;
 pub mod history;
 pub mod inputs;
 pub mod json;
-pub mod layout;
+pub(crate) mod layout;
 pub mod moves;
-pub mod recording;
-pub mod series;
+pub(crate) mod recording;
+pub(crate) mod series;
 pub mod suite;
 pub mod table;
 

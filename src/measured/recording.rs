@@ -11,12 +11,12 @@ use crate::rtest::clock::Recording;
 use crate::rtest::series::{EXT_COLUMNS, INT_COLUMNS, TIME_COLUMN};
 
 /// Reads the internal file of a two-system test: `t_s` and `{x,y,z}_int_mm`.
-pub fn read_internal(path: &Path, map: &ColumnMap) -> Result<Recording, MeasuredError> {
+pub(crate) fn read_internal(path: &Path, map: &ColumnMap) -> Result<Recording, MeasuredError> {
     read(path, map, &INT_COLUMNS)
 }
 
 /// Reads the external file of a two-system test: `t_s` and `{x,y,z}_ext_mm`.
-pub fn read_external(path: &Path, map: &ColumnMap) -> Result<Recording, MeasuredError> {
+pub(crate) fn read_external(path: &Path, map: &ColumnMap) -> Result<Recording, MeasuredError> {
     read(path, map, &EXT_COLUMNS)
 }
 

@@ -15,7 +15,7 @@ use crate::text::num;
 
 /// Whether a file looks like an EIJ table (its header has a `parameter` column) rather than a
 /// time series.
-pub fn looks_like_table(path: &Path) -> bool {
+pub(crate) fn looks_like_table(path: &Path) -> bool {
     // The header is found within the first lines; a pipe or a device is never sniffed (what
     // is read from it would be lost to the reader).
     let head = |path: &Path| -> std::io::Result<Vec<u8>> {
@@ -42,10 +42,10 @@ pub fn looks_like_table(path: &Path) -> bool {
 }
 
 /// Largest |EIJ| or standard error a table may give, µm·s²/m.
-pub const MAX_EIJ: f64 = 1e6;
+pub(crate) const MAX_EIJ: f64 = 1e6;
 
 /// Required columns, in the order written.
-pub const COLUMNS: [&str; 5] = [
+pub(crate) const COLUMNS: [&str; 5] = [
     "plane",
     "direction",
     "accel_m_s2",
@@ -53,7 +53,7 @@ pub const COLUMNS: [&str; 5] = [
     "value_um_s2_per_m",
 ];
 /// The optional standard-error column.
-pub const STD_ERR_COLUMN: &str = "std_err_um_s2_per_m";
+pub(crate) const STD_ERR_COLUMN: &str = "std_err_um_s2_per_m";
 
 /// One parameter value of one test condition.
 #[derive(Debug, Clone, PartialEq)]

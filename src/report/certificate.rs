@@ -17,12 +17,12 @@ use crate::rtest::diagnosis::tolerance::{Limits, Tolerances};
 use crate::rtest::diagnosis::Source;
 
 /// The anchor of the certificate.
-pub const ID: &str = "certificate";
+pub(crate) const ID: &str = "certificate";
 /// The last line of the certificate (the print check looks for it on the certificate's page).
-pub const END: &str = "End of certificate.";
+pub(crate) const END: &str = "End of certificate.";
 
 /// What the certificate states besides the tests.
-pub struct CertificateInput<'a> {
+pub(crate) struct CertificateInput<'a> {
     /// The evaluated tests.
     pub suite: &'a Suite,
     /// Their diagnosis and verdicts (`None` where it could not be made).
@@ -144,7 +144,7 @@ fn overall(d: Option<&SuiteDiagnosis>, n: usize) -> String {
 }
 
 /// Appends the certificate to `page`.
-pub fn certificate(page: &mut Page, c: &CertificateInput) {
+pub(crate) fn certificate(page: &mut Page, c: &CertificateInput) {
     let tests = &c.suite.tests;
     page.push("<div class=\"certificate\">\n");
     page.heading(2, ID, "Certificate of the circle tests");

@@ -365,7 +365,7 @@ pub struct OutOfPlane {
 
 /// The 1-2-5 magnification that draws `max_dev_mm` as at most `TARGET_FRACTION` (0.3) of r
 /// (1 when there is no deviation to magnify).
-pub fn magnification_for(max_dev_mm: f64, radius_mm: f64) -> f64 {
+pub(crate) fn magnification_for(max_dev_mm: f64, radius_mm: f64) -> f64 {
     if !(max_dev_mm.is_finite() && max_dev_mm > 1e-9 * radius_mm) {
         return 1.0;
     }

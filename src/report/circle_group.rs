@@ -17,7 +17,7 @@ use crate::measured::suite::{Bidirectional, EvaluatedTest, Suite};
 use crate::rtest::iso230::PathFigures;
 
 /// One group: its tests (cw before ccw) and their G(b) where they pair.
-pub struct CircleGroup<'a> {
+pub(crate) struct CircleGroup<'a> {
     /// The tests.
     pub tests: Vec<&'a EvaluatedTest>,
     /// Their indices in the suite.
@@ -71,7 +71,7 @@ fn group<'a>(
 }
 
 /// The groups of a suite, ordered by plane, circle centre and acceleration.
-pub fn groups(suite: &Suite) -> Result<Vec<CircleGroup<'_>>, ReportError> {
+pub(crate) fn groups(suite: &Suite) -> Result<Vec<CircleGroup<'_>>, ReportError> {
     let mut used = vec![false; suite.tests.len()];
     let mut out = Vec::new();
     for b in &suite.bidirectional {
@@ -99,7 +99,7 @@ pub fn groups(suite: &Suite) -> Result<Vec<CircleGroup<'_>>, ReportError> {
 }
 
 /// The scale every polar plot of the page shares.
-pub fn page_scale(groups: &[CircleGroup]) -> PolarScale {
+pub(crate) fn page_scale(groups: &[CircleGroup]) -> PolarScale {
     let max = groups
         .iter()
         .flat_map(|g| g.paths.iter())
@@ -118,7 +118,7 @@ fn test_label(t: &EvaluatedTest) -> String {
 }
 
 /// The polar figure and the out-of-plane figure of a group, the `number`th of the page.
-pub fn figures(
+pub(crate) fn figures(
     g: &CircleGroup,
     number: usize,
     scale: &PolarScale,
@@ -187,14 +187,14 @@ pub fn figures(
 }
 
 /// A µm value of the ISO table (2 decimals; `–` where there is none).
-pub fn fmt_um(v: Option<f64>) -> String {
+pub(crate) fn fmt_um(v: Option<f64>) -> String {
     v.filter(|v| v.is_finite())
         .map_or("–".into(), |v| format!("{v:.2}"))
 }
 
 /// The ISO 230-4 table of a group: per path (TCP and scales) and test G, F max, F min and
 /// the mean radius deviation, G(b) of the pair, and the test's conditions.
-pub fn iso_table(g: &CircleGroup) -> String {
+pub(crate) fn iso_table(g: &CircleGroup) -> String {
     let mut h =
         String::from("<table class=\"iso\">\n<tr><th class=\"l\">ISO 230-4, µm</th><th colspan=\"");
     let n = g.tests.len();
@@ -264,7 +264,7 @@ pub fn iso_table(g: &CircleGroup) -> String {
 /// The circle plots of the page: per plane a heading, per group the polar plot with, beside
 /// it, each test's verdict and breakdown by source (where `diagnosis` is given), the ISO table
 /// and the out-of-plane plot.
-pub fn section(
+pub(crate) fn section(
     page: &mut Page,
     groups: &[CircleGroup],
     figures: &[[Figure; 2]],

@@ -36,7 +36,7 @@ fn change(a: f64, sa: Option<f64>, b: f64, sb: Option<f64>) -> String {
 }
 
 /// The comparison section (for two or more reports).
-pub fn comparison(page: &mut Page, ids: &[LoadedIdent]) {
+pub(crate) fn comparison(page: &mut Page, ids: &[LoadedIdent]) {
     page.heading(2, "comparison", "Comparison of the identifications");
     let mut h = String::new();
     let _ = writeln!(

@@ -14,14 +14,14 @@ use crate::rtest::diagnosis::{CircleDiagnosis, Figure, Source, SourceDiagnosis, 
 use crate::text::unit_symbol;
 
 /// CSS class of a passed test or term.
-pub const PASS: &str = "v-pass";
+pub(crate) const PASS: &str = "v-pass";
 /// CSS class of a failed test or term.
-pub const FAIL: &str = "v-fail";
+pub(crate) const FAIL: &str = "v-fail";
 /// CSS class of a test without tolerances.
-pub const NOT_JUDGED: &str = "v-none";
+pub(crate) const NOT_JUDGED: &str = "v-none";
 
 /// The CSS class of a verdict (`pass`, `fail`, none).
-pub fn verdict_class(verdict: Option<&str>) -> &'static str {
+pub(crate) fn verdict_class(verdict: Option<&str>) -> &'static str {
     match verdict {
         Some("pass") => PASS,
         Some(_) => FAIL,
@@ -30,7 +30,7 @@ pub fn verdict_class(verdict: Option<&str>) -> &'static str {
 }
 
 /// A verdict as a coloured badge: `PASS`, `FAIL` or `not judged`.
-pub fn badge(verdict: Option<&str>) -> String {
+pub(crate) fn badge(verdict: Option<&str>) -> String {
     let text = match verdict {
         Some(v) => v.to_uppercase(),
         None => "not judged".into(),
@@ -42,7 +42,7 @@ pub fn badge(verdict: Option<&str>) -> String {
 }
 
 /// The failed checks of a verdict, each as `tcp G 13.15 > 12 µm` (G: the circular deviation).
-pub fn failed_checks(v: &Verdict) -> Vec<String> {
+pub(crate) fn failed_checks(v: &Verdict) -> Vec<String> {
     v.checks
         .iter()
         .filter(|c| c.verdict != "pass")
@@ -93,7 +93,7 @@ fn rows(d: &CircleDiagnosis) -> Vec<(String, Figure, f64)> {
 }
 
 /// `value ± std_err` with the standard error to two significant digits (1 to 6 decimals).
-pub fn value_se(value: f64, std_err: f64) -> String {
+pub(crate) fn value_se(value: f64, std_err: f64) -> String {
     let d = if std_err.is_finite() && std_err > 0.0 {
         (1.0 - std_err.log10().floor()).clamp(1.0, 6.0) as usize
     } else {
@@ -145,7 +145,11 @@ fn cell(t: Option<&Term>) -> String {
 }
 
 /// The breakdown of test `d` with its verdict first; `label` names the test (`cw: pos-a/…`).
-pub fn breakdown_html(d: &CircleDiagnosis, verdict: Option<&Verdict>, label: &str) -> String {
+pub(crate) fn breakdown_html(
+    d: &CircleDiagnosis,
+    verdict: Option<&Verdict>,
+    label: &str,
+) -> String {
     let v = verdict.map(|v| v.verdict);
     let mut h = format!(
         "<div class=\"diag\">\n<p class=\"diag-head\">{} <b>{}</b> — {:.0} mm/min; breakdown by \
@@ -250,7 +254,7 @@ fn notes_html(sources: &[SourceDiagnosis]) -> String {
 }
 
 /// The note above the circle plots: how to read the breakdowns.
-pub const READING_NOTE: &str = "Beside each plot, per test: its verdict against the \
+pub(crate) const READING_NOTE: &str = "Beside each plot, per test: its verdict against the \
     folder's [tolerances] (green PASS, red FAIL, grey not judged), then its deviation broken \
     down into named terms per source — the axes' own readings (what the drives and the control \
     did), external − internal (what the structure did), and the TCP (what a ballbar sees; to \

@@ -16,14 +16,14 @@ use crate::measured::history::{History, QuantityHistory, DRIFT_Z};
 use crate::text::unit_symbol;
 
 /// The colour of a run within its noise of the first.
-pub const STEADY: RGBColor = RGBColor(31, 119, 180);
+pub(crate) const STEADY: RGBColor = RGBColor(31, 119, 180);
 /// The colour of drift: the verdict's FAIL red.
-pub const DRIFT: RGBColor = RGBColor(187, 34, 34);
+pub(crate) const DRIFT: RGBColor = RGBColor(187, 34, 34);
 /// Size of a trend plot, px.
 const SIZE: (u32, u32) = (280, 110);
 
 /// The trend plot of one quantity: value ± standard error over the days since the first run.
-pub fn trend_svg(h: &History, q: &QuantityHistory) -> Result<String, ReportError> {
+pub(crate) fn trend_svg(h: &History, q: &QuantityHistory) -> Result<String, ReportError> {
     let days = |run: usize| h.runs[run].days;
     let (x0, x1) = padded_range(q.points.iter().map(|p| days(p.run)), 0.08);
     let (y0, y1) = padded_range(
@@ -74,7 +74,7 @@ pub fn trend_svg(h: &History, q: &QuantityHistory) -> Result<String, ReportError
 }
 
 /// Appends the history section to `page`.
-pub fn section(page: &mut Page, h: &History) -> Result<(), ReportError> {
+pub(crate) fn section(page: &mut Page, h: &History) -> Result<(), ReportError> {
     page.heading(2, "history", "History");
     let mut out = String::new();
     let machine = h

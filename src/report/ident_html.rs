@@ -11,7 +11,7 @@ use super::verdict::LoadedIdent;
 use super::{identification_svg, short, ReportError};
 
 /// The identification figure of `id`.
-pub fn figure(id: &LoadedIdent) -> Result<Figure, ReportError> {
+pub(crate) fn figure(id: &LoadedIdent) -> Result<Figure, ReportError> {
     Ok(Figure {
         id: anchor(&format!("identification-figure-{}", id.letter)),
         caption: format!(
@@ -23,7 +23,7 @@ pub fn figure(id: &LoadedIdent) -> Result<Figure, ReportError> {
 }
 
 /// The details section of one identification.
-pub fn details(page: &mut Page, id: &LoadedIdent, fig: &Figure) {
+pub(crate) fn details(page: &mut Page, id: &LoadedIdent, fig: &Figure) {
     let rep = &id.report;
     page.heading(
         3,

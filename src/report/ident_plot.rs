@@ -12,7 +12,7 @@ use crate::ident::report::{IdentReport, TestReport};
 
 /// Short label of a test with its circle centre where known, e.g. `zx ccw 4 @ 150,-100,0`:
 /// tests at two positions must be told apart.
-pub fn test_label(t: &TestReport) -> String {
+pub(crate) fn test_label(t: &TestReport) -> String {
     let base = format!("{} {} {}", t.plane, t.direction, short(t.accel_m_s2, 1));
     match &t.position_mm {
         Some(p) => format!("{base} @ {}", super::labels::position_label(p)),

@@ -10,7 +10,7 @@ use crate::measured::suite::EvaluatedTest;
 use crate::rtest::CircleResult;
 
 /// The name of a test with its circle centre: `pos-a/xy_ccw_2.csv @ 150,-100,0 mm`.
-pub fn test_name(t: &EvaluatedTest) -> String {
+pub(crate) fn test_name(t: &EvaluatedTest) -> String {
     let name = folder_and_name(t.input.primary_file());
     match &t.input.position_mm {
         Some(p) => format!("{name} @ {} mm", position_label(p)),
@@ -34,7 +34,7 @@ pub fn distinct(values: impl Iterator<Item = f64>, decimals: usize) -> String {
 
 /// The conditions of a set of tests in one line: count, planes, directions, set radius,
 /// accelerations, feeds and circle centres.
-pub fn conditions_line(t: &[EvaluatedTest]) -> String {
+pub(crate) fn conditions_line(t: &[EvaluatedTest]) -> String {
     let planes: BTreeSet<String> = t.iter().map(|t| t.result.plane.to_string()).collect();
     let dirs: BTreeSet<String> = t.iter().map(|t| t.result.direction.to_string()).collect();
     let centres: BTreeSet<String> = t
@@ -68,7 +68,7 @@ pub fn conditions_line(t: &[EvaluatedTest]) -> String {
 
 /// `folder/name` of a path: the name alone is ambiguous when several folders (test positions)
 /// hold files of the same name.
-pub fn folder_and_name(path: &Path) -> String {
+pub(crate) fn folder_and_name(path: &Path) -> String {
     let name = path
         .file_name()
         .map(|f| f.to_string_lossy().into_owned())
@@ -81,7 +81,7 @@ pub fn folder_and_name(path: &Path) -> String {
 
 /// The folders of `files` with the number of files in each, in order of appearance:
 /// `measurements/demo-vmc/pos-a (18 files)`.
-pub fn folders_of<'a>(files: impl Iterator<Item = &'a Path>) -> Vec<String> {
+pub(crate) fn folders_of<'a>(files: impl Iterator<Item = &'a Path>) -> Vec<String> {
     let mut folders: Vec<(String, usize)> = Vec::new();
     for f in files {
         let dir = f
@@ -110,7 +110,7 @@ pub fn fmt_eij(v: f64) -> String {
 }
 
 /// Axis positions as written in labels: `150,-100,0`.
-pub fn position_label(p: &[f64]) -> String {
+pub(crate) fn position_label(p: &[f64]) -> String {
     p.iter().map(|v| short(*v, 1)).collect::<Vec<_>>().join(",")
 }
 

@@ -103,7 +103,7 @@ table.cert td.w{max-width:260px}.certificate .badge{font-size:9px;padding:0 4px}
 
 /// A page under construction: the body text and the headings for the table of contents.
 #[derive(Debug, Default)]
-pub struct Page {
+pub(crate) struct Page {
     body: String,
     /// (level, anchor, title) of every h2 and h3.
     toc: Vec<(u8, String, String)>,
@@ -111,7 +111,7 @@ pub struct Page {
 
 impl Page {
     /// A heading of `level` (2 or 3) with anchor `id`, listed in the table of contents.
-    pub fn heading(&mut self, level: u8, id: &str, title: &str) {
+    pub(crate) fn heading(&mut self, level: u8, id: &str, title: &str) {
         let _ = writeln!(
             self.body,
             "<h{level} id=\"{id}\">{}</h{level}>",
@@ -121,18 +121,18 @@ impl Page {
     }
 
     /// Raw HTML appended to the body.
-    pub fn push(&mut self, html: &str) {
+    pub(crate) fn push(&mut self, html: &str) {
         self.body.push_str(html);
     }
 
     /// A figure with its caption, the SVG inline.
-    pub fn figure(&mut self, f: &Figure) {
+    pub(crate) fn figure(&mut self, f: &Figure) {
         self.push(&figure_html(f));
     }
 
     /// A figure with `beside` (HTML, e.g. a table) to its right where the page is wide enough,
     /// else below it.
-    pub fn figure_beside(&mut self, f: &Figure, beside: &str) {
+    pub(crate) fn figure_beside(&mut self, f: &Figure, beside: &str) {
         let width = svg_width(&f.svg).unwrap_or(800);
         let fig = figure_html(f).replacen(
             "<figure ",
@@ -145,7 +145,7 @@ impl Page {
     }
 
     /// The whole document: title, `header` (HTML), the table of contents, the body.
-    pub fn finish(self, title: &str, header: &str) -> String {
+    pub(crate) fn finish(self, title: &str, header: &str) -> String {
         let mut h = String::new();
         let _ = writeln!(
             h,

@@ -21,9 +21,9 @@ use crate::rtest::normalise::circle_centre;
 use crate::rtest::{CircleSeries, EvalOptions};
 
 /// Colour of clockwise paths.
-pub const CW: RGBColor = RGBColor(0, 114, 178);
+pub(crate) const CW: RGBColor = RGBColor(0, 114, 178);
 /// Colour of counter-clockwise paths.
-pub const CCW: RGBColor = RGBColor(213, 94, 0);
+pub(crate) const CCW: RGBColor = RGBColor(213, 94, 0);
 /// Points per drawn path at most.
 const MAX_POINTS: usize = 1500;
 /// Out-of-plane points per test at most.
@@ -33,7 +33,7 @@ const MAX_SCATTER: usize = 500;
 const HALF_SPAN: f64 = 0.5;
 
 /// The colour of a direction.
-pub fn direction_color(d: Direction) -> RGBColor {
+pub(crate) fn direction_color(d: Direction) -> RGBColor {
     match d {
         Direction::Cw => CW,
         Direction::Ccw => CCW,
@@ -42,7 +42,7 @@ pub fn direction_color(d: Direction) -> RGBColor {
 
 /// The polar µm scale shared by the plots of a page.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PolarScale {
+pub(crate) struct PolarScale {
     /// Radial deviation between two rings, µm (1-2-5 sequence).
     pub ring_um: f64,
     /// Rings on each side of the nominal circle.
@@ -52,7 +52,7 @@ pub struct PolarScale {
 impl PolarScale {
     /// The scale whose outermost rings enclose `max_dev_um` (the largest |ρ − r| of any path of
     /// the page) with two to five rings a side.
-    pub fn enclosing(max_dev_um: f64) -> PolarScale {
+    pub(crate) fn enclosing(max_dev_um: f64) -> PolarScale {
         if !(max_dev_um.is_finite() && max_dev_um > 0.0) {
             return PolarScale {
                 ring_um: 1.0,
@@ -81,7 +81,7 @@ impl PolarScale {
 /// One path of a test in polar form about a centre: angle (rad) and radial deviation (µm) per
 /// sample of the steady revolutions, in time order.
 #[derive(Debug, Clone, PartialEq)]
-pub struct PolarPath {
+pub(crate) struct PolarPath {
     /// Angle of each sample about the centre, rad.
     pub angle: Vec<f64>,
     /// ρ − r per sample, µm.
@@ -92,7 +92,7 @@ pub struct PolarPath {
 
 /// The in-plane coordinates (a, b) of a test's internal or external path over its steady
 /// revolutions, mm.
-pub fn steady_path(t: &EvaluatedTest, external: bool) -> (Vec<f64>, Vec<f64>) {
+pub(crate) fn steady_path(t: &EvaluatedTest, external: bool) -> (Vec<f64>, Vec<f64>) {
     let (a, b) = t.result.plane.axes();
     let s: &CircleSeries = &t.series;
     let col = |ax| {
@@ -104,7 +104,7 @@ pub fn steady_path(t: &EvaluatedTest, external: bool) -> (Vec<f64>, Vec<f64>) {
 
 /// The paths of `tests` (internal or external) in polar form about the least-squares centre
 /// of all of them together; `None` when no centre can be fitted.
-pub fn polar_paths(tests: &[&EvaluatedTest], external: bool) -> Option<Vec<PolarPath>> {
+pub(crate) fn polar_paths(tests: &[&EvaluatedTest], external: bool) -> Option<Vec<PolarPath>> {
     let paths: Vec<(Vec<f64>, Vec<f64>)> = tests.iter().map(|t| steady_path(t, external)).collect();
     let all_a: Vec<f64> = paths.iter().flat_map(|p| p.0.iter().copied()).collect();
     let all_b: Vec<f64> = paths.iter().flat_map(|p| p.1.iter().copied()).collect();
@@ -137,7 +137,7 @@ pub fn polar_paths(tests: &[&EvaluatedTest], external: bool) -> Option<Vec<Polar
 }
 
 /// The largest |ρ − r| of the paths, µm.
-pub fn max_deviation_um(paths: &[PolarPath]) -> f64 {
+pub(crate) fn max_deviation_um(paths: &[PolarPath]) -> f64 {
     paths
         .iter()
         .flat_map(|p| p.dev_um.iter())
@@ -147,7 +147,7 @@ pub fn max_deviation_um(paths: &[PolarPath]) -> f64 {
 /// What a polar figure shows: title, condition lines, the paths of the two panels (external,
 /// internal) and the legend labels of the tests.
 #[derive(Debug, Clone)]
-pub struct PolarFigure {
+pub(crate) struct PolarFigure {
     /// Title.
     pub title: String,
     /// Condition lines under the title.
@@ -163,7 +163,7 @@ pub struct PolarFigure {
 }
 
 /// The figure: the TCP (R-Test) panel and the scales panel side by side on `scale`.
-pub fn polar_svg(fig: &PolarFigure, scale: &PolarScale) -> Result<String, ReportError> {
+pub(crate) fn polar_svg(fig: &PolarFigure, scale: &PolarScale) -> Result<String, ReportError> {
     let panel = 430u32;
     let header_px = 16 + 30 + 22 * fig.lines.len() as u32 + 6;
     let legend_px = 20 + 24 * (fig.labels.len() + 1).div_ceil(2) as u32;
@@ -333,7 +333,7 @@ fn start_and_arrow(
 
 /// The out-of-plane deviation d_k of each test over the phase with its fitted plane
 /// d_k = E_ka ä_a + E_kb ä_b + c_k, cw and ccw overlaid.
-pub fn out_of_plane_svg(
+pub(crate) fn out_of_plane_svg(
     title: &str,
     lines: &[String],
     tests: &[(&EvaluatedTest, String)],

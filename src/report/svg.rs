@@ -9,7 +9,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 /// The drawing area type of every figure.
-pub type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
+pub(crate) type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
 
 /// Set circle / set values (black).
 pub const SET: RGBColor = RGBColor(0, 0, 0);
@@ -26,22 +26,22 @@ pub const FIT: RGBColor = RGBColor(44, 160, 44);
 /// A second deviation series (the other cross-talk axis).
 pub const SECOND: RGBColor = RGBColor(148, 103, 189);
 /// Simulation before identification.
-pub const INITIAL: RGBColor = RGBColor(127, 127, 127);
+pub(crate) const INITIAL: RGBColor = RGBColor(127, 127, 127);
 /// Error bars (distinct from the black tick marks).
 pub const ERROR_BAR: RGBColor = RGBColor(90, 90, 90);
 /// Grid and frame.
 const GRID: RGBColor = RGBColor(225, 225, 225);
 
 /// Font family of all text.
-pub const FONT: &str = "sans-serif";
+pub(crate) const FONT: &str = "sans-serif";
 /// Title size (plotters units; the SVG font-size is this / 1.24).
-pub const TITLE_SIZE: f64 = 22.0;
+pub(crate) const TITLE_SIZE: f64 = 22.0;
 /// Size of condition lines, legend, notes.
-pub const TEXT_SIZE: f64 = 16.0;
+pub(crate) const TEXT_SIZE: f64 = 16.0;
 /// Size of tick labels.
-pub const LABEL_SIZE: f64 = 15.0;
+pub(crate) const LABEL_SIZE: f64 = 15.0;
 /// Size of axis descriptions.
-pub const DESC_SIZE: f64 = 16.0;
+pub(crate) const DESC_SIZE: f64 = 16.0;
 
 /// The colour as plotters writes it into `stroke`/`fill` attributes, e.g. `#D62728`.
 pub fn svg_color(c: RGBColor) -> String {
@@ -99,7 +99,7 @@ pub fn header<'a>(area: &Area<'a>, title: &str, lines: &[String]) -> Result<Area
 
 /// How a series appears in the legend.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Mark {
+pub(crate) enum Mark {
     /// A line.
     Line,
     /// Filled dots.
@@ -112,7 +112,7 @@ pub enum Mark {
 
 /// One legend line.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Entry {
+pub(crate) struct Entry {
     /// Series label.
     pub label: String,
     /// Series colour.
@@ -123,7 +123,7 @@ pub struct Entry {
 
 impl Entry {
     /// A legend entry.
-    pub fn new(label: impl Into<String>, color: RGBColor, mark: Mark) -> Self {
+    pub(crate) fn new(label: impl Into<String>, color: RGBColor, mark: Mark) -> Self {
         Entry {
             label: label.into(),
             color,
@@ -133,7 +133,11 @@ impl Entry {
 }
 
 /// A legend (symbol + label per entry) and then note lines, top-left in `area`.
-pub fn side_panel(area: &Area, legend: &[Entry], notes: &[String]) -> Result<(), ReportError> {
+pub(crate) fn side_panel(
+    area: &Area,
+    legend: &[Entry],
+    notes: &[String],
+) -> Result<(), ReportError> {
     let x0 = 8;
     let mut y = 16;
     for e in legend {
@@ -175,7 +179,7 @@ pub fn side_panel(area: &Area, legend: &[Entry], notes: &[String]) -> Result<(),
 }
 
 /// The largest number of the 1-2-5 sequence not above `x` (x > 0).
-pub fn nice_floor(x: f64) -> f64 {
+pub(crate) fn nice_floor(x: f64) -> f64 {
     let decade = 10f64.powf(x.log10().floor());
     let m = x / decade;
     let step = if m >= 5.0 {
@@ -189,7 +193,7 @@ pub fn nice_floor(x: f64) -> f64 {
 }
 
 /// Decimals that resolve a tick step over `span`: about five ticks.
-pub fn decimals_for(span: f64) -> usize {
+pub(crate) fn decimals_for(span: f64) -> usize {
     if !(span.is_finite() && span > 0.0) {
         return 1;
     }
@@ -198,7 +202,7 @@ pub fn decimals_for(span: f64) -> usize {
 }
 
 /// A padded range around the finite values of `values` (±1 around a single value).
-pub fn padded_range(values: impl IntoIterator<Item = f64>, pad: f64) -> (f64, f64) {
+pub(crate) fn padded_range(values: impl IntoIterator<Item = f64>, pad: f64) -> (f64, f64) {
     let (lo, hi) = values
         .into_iter()
         .filter(|v| v.is_finite())
@@ -246,7 +250,7 @@ pub fn mesh<DB: DrawingBackend>(
 }
 
 /// Every `stride`-th index so that at most `max` points remain (the last index kept).
-pub fn decimate(n: usize, max: usize) -> impl Iterator<Item = usize> {
+pub(crate) fn decimate(n: usize, max: usize) -> impl Iterator<Item = usize> {
     let stride = n.div_ceil(max.max(1)).max(1);
     (0..n)
         .step_by(stride)

@@ -129,7 +129,7 @@ fn standing_class(s: Standing) -> &'static str {
 /// refusal is coloured (red, like its verdict): whether an exported result may be used is the
 /// verdict's to say, in the verdict's one colour, never a second, green "accepted" beside a
 /// red verdict.
-pub fn status_html(id: &LoadedIdent) -> String {
+pub(crate) fn status_html(id: &LoadedIdent) -> String {
     if id.refused() {
         format!(
             "<span class=\"bad\">REFUSED</span> (nothing exported): {}",
@@ -145,7 +145,7 @@ pub fn status_html(id: &LoadedIdent) -> String {
 }
 
 /// `s = 0.949 over 172 degrees of freedom: χ² test passed …`.
-pub fn fit_quality(r: &IdentReport) -> String {
+pub(crate) fn fit_quality(r: &IdentReport) -> String {
     match (r.chi2(), r.residual_std) {
         (Some(c), _) => format!("residual std s = {:.3}; χ² test {}", c.s, c.describe()),
         (None, Some(s)) => format!(
@@ -156,7 +156,7 @@ pub fn fit_quality(r: &IdentReport) -> String {
 }
 
 /// The warnings as a list (`none` when there are none).
-pub fn warnings_html(warnings: &[String]) -> String {
+pub(crate) fn warnings_html(warnings: &[String]) -> String {
     if warnings.is_empty() {
         return "<p><b>Warnings:</b> none.</p>\n".into();
     }
@@ -173,7 +173,7 @@ pub fn warnings_html(warnings: &[String]) -> String {
 
 /// The parameter table of one identification: value ± standard error, σ/value, standing,
 /// bound and plausibility.
-pub fn parameters_html(r: &IdentReport) -> String {
+pub(crate) fn parameters_html(r: &IdentReport) -> String {
     let mut h = String::from(
         "<table>\n<tr><th class=\"l\">parameter</th><th>initial</th><th>identified</th>\
          <th>± std err</th><th>σ/value</th><th>3σ interval (in 1/p)</th><th class=\"l\">standing</th><th class=\"l\">remark</th></tr>\n",
@@ -224,7 +224,7 @@ pub fn parameters_html(r: &IdentReport) -> String {
 }
 
 /// The verdict of one identification as a framed block.
-pub fn ident_verdict_html(id: &LoadedIdent) -> String {
+pub(crate) fn ident_verdict_html(id: &LoadedIdent) -> String {
     let r = &id.report;
     let head = headline(id);
     let mut h = format!(
@@ -261,7 +261,7 @@ pub fn ident_verdict_html(id: &LoadedIdent) -> String {
 }
 
 /// Every warning of the circle evaluations, per test, and of the set (clocks).
-pub fn circle_warnings_html(tests: &[(String, Vec<String>)], set: &[String]) -> String {
+pub(crate) fn circle_warnings_html(tests: &[(String, Vec<String>)], set: &[String]) -> String {
     let n: usize = tests.iter().map(|(_, w)| w.len()).sum::<usize>() + set.len();
     if n == 0 {
         return "<p><b>Circle-test evaluation:</b> no warnings (the paper's plane and ellipse routes agree with the joint fit within noise, conditions agree with the data).</p>\n".into();

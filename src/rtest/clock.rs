@@ -23,11 +23,11 @@ use super::error::{Location, RtestError};
 use super::series::CircleSeries;
 
 /// Least overlap of the two records, as a share of the shorter one.
-pub const MIN_OVERLAP: f64 = 0.5;
+pub(crate) const MIN_OVERLAP: f64 = 0.5;
 
 /// One system's recording of a two-system test: its time and its three position columns.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Recording {
+pub(crate) struct Recording {
     /// The file (or in-memory name).
     pub source: String,
     /// Time on this system's clock, s, strictly increasing.
@@ -41,7 +41,11 @@ pub struct Recording {
 impl Recording {
     /// A recording from memory, validated: equal lengths, at least four rows, finite values,
     /// time strictly increasing.
-    pub fn new(source: String, t_s: Vec<f64>, mm: [Vec<f64>; 3]) -> Result<Self, RtestError> {
+    pub(crate) fn new(
+        source: String,
+        t_s: Vec<f64>,
+        mm: [Vec<f64>; 3],
+    ) -> Result<Self, RtestError> {
         let r = Recording {
             source,
             t_s,
@@ -54,7 +58,7 @@ impl Recording {
 
     /// A recording read from a file (`lines`: the file line of every row), validated as
     /// [`Recording::new`]; the readers are in [`crate::measured`].
-    pub fn with_lines(
+    pub(crate) fn with_lines(
         source: String,
         t_s: Vec<f64>,
         mm: [Vec<f64>; 3],
@@ -125,20 +129,20 @@ impl Recording {
     }
 
     /// Median sample interval, s.
-    pub fn median_dt(&self) -> f64 {
+    pub(crate) fn median_dt(&self) -> f64 {
         let mut dt: Vec<f64> = self.t_s.windows(2).map(|w| w[1] - w[0]).collect();
         let mid = dt.len() / 2;
         *dt.select_nth_unstable_by(mid, f64::total_cmp).1
     }
 
     /// Duration, s.
-    pub fn span_s(&self) -> f64 {
+    pub(crate) fn span_s(&self) -> f64 {
         self.t_s[self.t_s.len() - 1] - self.t_s[0]
     }
 
     /// The recording's values at times `t` of its own clock (cubic, see the module docs), or
     /// `None` outside its second to second-last sample.
-    pub fn sample(&self, t: f64, hint: &mut usize) -> Option<[f64; 3]> {
+    pub(crate) fn sample(&self, t: f64, hint: &mut usize) -> Option<[f64; 3]> {
         let w = cubic_weights(&self.t_s, t, hint)?;
         Some(std::array::from_fn(|c| {
             (0..4).map(|k| w.1[k] * self.mm[c][w.0 + k]).sum()
@@ -188,7 +192,7 @@ fn cubic_weights(times: &[f64], t: f64, hint: &mut usize) -> Option<(usize, [f64
 /// (its samples stay as recorded, the other one is interpolated onto them, so that no sample
 /// is invented and the residuals stay independent); time is on the internal clock. Samples
 /// where the other recording does not reach are dropped.
-pub fn merge(
+pub(crate) fn merge(
     name: String,
     internal: &Recording,
     external: &Recording,
@@ -239,7 +243,7 @@ pub fn merge(
 
 /// The clock offset that best aligns the two paths, from the trajectories alone.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Alignment {
+pub(crate) struct Alignment {
     /// Internal clock minus external clock, s.
     pub offset_s: f64,
     /// RMS distance of the aligned paths over the overlap, µm.
@@ -300,7 +304,7 @@ impl CostFunction for Misfit<'_> {
 /// [`MIN_OVERLAP`] of overlap (steps of 1/20 of the circle period, at most 200 000 steps; the
 /// misfit of the grid on about 25 internal samples per period), then Brent's method (argmin,
 /// on every sample) between the grid neighbours of the best point. `period_s` is the circle's period, for the grid step and the uniqueness check.
-pub fn align(
+pub(crate) fn align(
     internal: &Recording,
     external: &Recording,
     period_s: f64,

@@ -37,7 +37,7 @@ const MIN_SIGMA_UM: f64 = 1e-3;
 /// One test of the fit: its normalisation and the key of its group (tests that share EIJ:
 /// one plane at one position).
 #[derive(Debug, Clone, Copy)]
-pub struct OffsetTest<'a> {
+pub(crate) struct OffsetTest<'a> {
     /// The normalised test (merged at the base offset).
     pub norm: &'a Normalised,
     /// Tests with equal keys share EIJ and static geometry (same plane, same position).
@@ -46,7 +46,7 @@ pub struct OffsetTest<'a> {
 
 /// The fitted clock offset.
 #[derive(Debug, Clone, PartialEq)]
-pub struct OffsetFit {
+pub(crate) struct OffsetFit {
     /// Whether the tests separate δ from cross-talk (see the module docs); when false, δ is 0
     /// and `reason` says why.
     pub separable: bool,
@@ -116,7 +116,7 @@ fn per_test(norm: &Normalised, group: usize) -> Option<PerTest> {
 
 /// Fits the residual clock offset δ shared by `tests` (see the module docs). `None` when a
 /// per-test or the joint least-squares problem has no unique solution.
-pub fn fit_offset(tests: &[OffsetTest]) -> Option<OffsetFit> {
+pub(crate) fn fit_offset(tests: &[OffsetTest]) -> Option<OffsetFit> {
     let mut keys: Vec<&str> = tests.iter().map(|t| t.group).collect();
     keys.sort();
     keys.dedup();

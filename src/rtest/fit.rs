@@ -24,7 +24,7 @@ pub struct JointFit {
 /// d_i = E_ia ä_a + E_ib ä_b + c_i for i = a, b, k. One QR of [ä_a, ä_b, 1] serves all three
 /// components; each component's standard errors use its own residual variance
 /// s² = rᵀr/(n − 3), cov = s² (XᵀX)⁻¹.
-pub fn joint(norm: &Normalised) -> Option<JointFit> {
+pub(crate) fn joint(norm: &Normalised) -> Option<JointFit> {
     let n = norm.samples();
     let fit = joint_lstsq(norm)?;
     let (a, b) = norm.plane.axes();
@@ -48,7 +48,7 @@ pub fn joint(norm: &Normalised) -> Option<JointFit> {
 
 /// The least-squares problem of [`joint`]: [ä_a, ä_b, 1] against [d_a, d_b, d_k] (rows of
 /// the coefficients: E_·a, E_·b, offset; columns: components a, b, k).
-pub fn joint_lstsq(norm: &Normalised) -> Option<Lstsq> {
+pub(crate) fn joint_lstsq(norm: &Normalised) -> Option<Lstsq> {
     let n = norm.samples();
     let [acc_a, acc_b] = &norm.acc_m_s2;
     let x = DMatrix::from_fn(n, 3, |i, j| match j {
@@ -67,7 +67,7 @@ pub fn joint_lstsq(norm: &Normalised) -> Option<Lstsq> {
 /// With φ and ω shared, [ä_a, ä_b] = −ω² [a_set, b_set] holds sample by sample, so this is the
 /// joint fit's normal row in a rescaled regressor: the two agree to rounding (theory: exactly).
 /// It is kept as the paper's route and as a check of the sign and scale of ä.
-pub fn plane_route(norm: &Normalised) -> Option<EijEstimates> {
+pub(crate) fn plane_route(norm: &Normalised) -> Option<EijEstimates> {
     let n = norm.samples();
     let [sa, sb] = &norm.set_mm;
     let x = DMatrix::from_fn(n, 3, |i, j| match j {
@@ -112,7 +112,12 @@ impl Ellipse {
 /// (u, v) = ((a − a_c)/r, (b − b_c)/r). Centring and scaling make the columns O(1); on raw
 /// µm-on-mm coordinates this system is ill-conditioned and is deliberately not offered.
 /// `None` unless the conic is a real ellipse.
-pub fn fit_ellipse(a: &[f64], b: &[f64], centre_mm: [f64; 2], radius_mm: f64) -> Option<Ellipse> {
+pub(crate) fn fit_ellipse(
+    a: &[f64],
+    b: &[f64],
+    centre_mm: [f64; 2],
+    radius_mm: f64,
+) -> Option<Ellipse> {
     let n = a.len();
     let u = |i: usize| (a[i] - centre_mm[0]) / radius_mm;
     let v = |i: usize| (b[i] - centre_mm[1]) / radius_mm;
@@ -161,7 +166,7 @@ pub struct EllipseRoute {
 }
 
 /// Fits both ellipses over the steady revolutions and converts them to in-talk.
-pub fn ellipse_route(
+pub(crate) fn ellipse_route(
     norm: &Normalised,
     int_mm: [&[f64]; 2],
     ext_mm: [&[f64]; 2],
@@ -188,7 +193,7 @@ pub fn ellipse_route(
 /// model: x_ext = x_int + (E_p ä)/1000 mm with the in-plane 2×2 block E_p of `eij`. The route's
 /// own nonlinearity (second order in ε, the internal path's ellipticity) is then the same for
 /// both, so the measured route differs from this prediction by noise only.
-pub fn predict_ellipse_route(
+pub(crate) fn predict_ellipse_route(
     norm: &Normalised,
     int_mm: [&[f64]; 2],
     eij: &EijEstimates,

@@ -6,7 +6,7 @@ use nalgebra::DMatrix;
 /// Solution of an ordinary least-squares problem X·B = Y (several right-hand sides), by
 /// Householder QR of X.
 #[derive(Debug, Clone)]
-pub struct Lstsq {
+pub(crate) struct Lstsq {
     /// Coefficients B, p × m.
     pub coef: DMatrix<f64>,
     /// Residual sum of squares per right-hand side.
@@ -19,19 +19,19 @@ pub struct Lstsq {
 
 impl Lstsq {
     /// Residual variance s² = rᵀr / (n − p) of right-hand side `col`.
-    pub fn residual_variance(&self, col: usize) -> f64 {
+    pub(crate) fn residual_variance(&self, col: usize) -> f64 {
         self.rss[col] / (self.n - self.coef.nrows()) as f64
     }
 
     /// Standard error of coefficient `row` for right-hand side `col`: √(s² (XᵀX)⁻¹ᵢᵢ).
-    pub fn std_err(&self, row: usize, col: usize) -> f64 {
+    pub(crate) fn std_err(&self, row: usize, col: usize) -> f64 {
         (self.residual_variance(col) * self.cov_unscaled[(row, row)]).sqrt()
     }
 }
 
 /// Least squares X·B ≈ Y by QR. `None` when n ≤ p or X is rank deficient (a diagonal entry
 /// of R below 1e-10 of its column's norm).
-pub fn lstsq(x: DMatrix<f64>, mut y: DMatrix<f64>) -> Option<Lstsq> {
+pub(crate) fn lstsq(x: DMatrix<f64>, mut y: DMatrix<f64>) -> Option<Lstsq> {
     let (n, p) = x.shape();
     if n <= p || y.nrows() != n {
         return None;

@@ -37,19 +37,19 @@ use serde_json::{json, Value};
 use crate::axes::{Axis, Direction, Eij, EijEstimates, EijMap, Plane};
 
 pub mod checks;
-pub mod clock;
-pub mod clock_fit;
+pub(crate) mod clock;
+pub(crate) mod clock_fit;
 pub mod diagnosis;
-pub mod error;
-pub mod fit;
+pub(crate) mod error;
+pub(crate) mod fit;
 pub mod harmonic;
 pub mod iso230;
-pub mod lstsq;
+pub(crate) mod lstsq;
 pub mod moves;
 pub mod normalise;
 pub mod pooled;
-pub mod series;
-pub mod warning;
+pub(crate) mod series;
+pub(crate) mod warning;
 
 pub use error::{Line, Location, RtestError};
 pub use pooled::{evaluate_pooled, PooledResult};
@@ -216,6 +216,6 @@ pub fn evaluate(series: &CircleSeries, opts: &EvalOptions) -> Result<CircleResul
 }
 
 /// A parameter map as a JSON object keyed by the parameter names (`EZZ`, ...).
-pub fn eij_json(map: &EijMap) -> Value {
+pub(crate) fn eij_json(map: &EijMap) -> Value {
     Value::Object(map.iter().map(|(k, v)| (k.name(), json!(v))).collect())
 }

@@ -60,7 +60,11 @@ pub struct MoveRecord {
 }
 
 /// Evaluates a move of axis `axis` (`source` names its file in messages).
-pub fn evaluate_record(rec: &MoveRecord, source: String, axis: Axis) -> Result<MoveEij, MoveError> {
+pub(crate) fn evaluate_record(
+    rec: &MoveRecord,
+    source: String,
+    axis: Axis,
+) -> Result<MoveEij, MoveError> {
     let n = rec.t.len();
     let peak = rec.set[2].iter().fold(0.0_f64, |m, a| m.max(a.abs()));
     let fit_err = |message: String| MoveError {

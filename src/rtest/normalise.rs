@@ -12,7 +12,7 @@ use std::f64::consts::{PI, TAU};
 pub use super::checks::PROBE_RANGE_MM;
 use super::checks::{check_external, check_probe_range, check_time_scale, check_units};
 /// Relative band around the plateau angular speed that counts as steady.
-pub const STEADY_TOLERANCE: f64 = 0.005;
+pub(crate) const STEADY_TOLERANCE: f64 = 0.005;
 
 /// The wider band of the first pass, whose phase is taken about the mid-range centre: a centre
 /// off by δ makes the local speed ripple by ±δ/r (a file that starts at rest on the set radius
@@ -267,7 +267,7 @@ fn mean(v: &[f64]) -> f64 {
 }
 
 /// φ_k = atan2(b − b_c, a − a_c) (eq. 5), unwrapped to a continuous sequence.
-pub fn unwrapped_phase(a: &[f64], b: &[f64], centre: [f64; 2]) -> Vec<f64> {
+pub(crate) fn unwrapped_phase(a: &[f64], b: &[f64], centre: [f64; 2]) -> Vec<f64> {
     let mut out = Vec::with_capacity(a.len());
     let mut prev_raw = 0.0;
     let mut acc = 0.0;

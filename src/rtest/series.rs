@@ -6,13 +6,13 @@ use super::error::{Line, Location, RtestError};
 use crate::axes::Axis;
 
 /// Column names of the internal readings, x, y, z.
-pub const INT_COLUMNS: [&str; 3] = ["x_int_mm", "y_int_mm", "z_int_mm"];
+pub(crate) const INT_COLUMNS: [&str; 3] = ["x_int_mm", "y_int_mm", "z_int_mm"];
 /// Column names of the external (R-Test) readings, x, y, z.
-pub const EXT_COLUMNS: [&str; 3] = ["x_ext_mm", "y_ext_mm", "z_ext_mm"];
+pub(crate) const EXT_COLUMNS: [&str; 3] = ["x_ext_mm", "y_ext_mm", "z_ext_mm"];
 /// Column name of the time.
-pub const TIME_COLUMN: &str = "t_s";
+pub(crate) const TIME_COLUMN: &str = "t_s";
 /// The contract columns of an R-Test series: time, internal x, y, z, external x, y, z.
-pub const CONTRACT_COLUMNS: [&str; 7] = [
+pub(crate) const CONTRACT_COLUMNS: [&str; 7] = [
     "t_s", "x_int_mm", "y_int_mm", "z_int_mm", "x_ext_mm", "y_ext_mm", "z_ext_mm",
 ];
 

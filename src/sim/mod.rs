@@ -259,7 +259,7 @@ pub fn simulate_segments(segments: &[Segment], setpoint: &dyn SetPoint) -> Resul
 }
 
 /// Longest stretch of a move simulated on one assembly of the model, m (see [`move_segments`]).
-pub const MOVE_SEGMENT_M: f64 = 0.01;
+pub(crate) const MOVE_SEGMENT_M: f64 = 0.01;
 
 /// The segments of a jerk-limited move of axis `axis_index` from `start_m` (machine axis order):
 /// the travel is cut into ⌈|D| / 10 mm⌉ equal stretches, each simulated on the model assembled at

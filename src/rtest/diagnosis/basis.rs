@@ -9,7 +9,7 @@ use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 /// What the regressors need to know about the circle besides θ.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Circle {
+pub(crate) struct Circle {
     /// Set radius r, mm.
     pub radius_mm: f64,
     /// Signed angular speed ω, rad/s (positive ccw).
@@ -24,13 +24,13 @@ pub struct Circle {
 
 impl Circle {
     /// +1 ccw, −1 cw.
-    pub fn sense(&self) -> f64 {
+    pub(crate) fn sense(&self) -> f64 {
         self.omega_rad_s.signum()
     }
 
     /// The sign of the nominal velocity of in-plane axis `axis` (0 = a, 1 = b) at θ:
     /// v_a = −rω sin θ, v_b = rω cos θ.
-    pub fn velocity_sign(&self, axis: usize, theta: f64) -> f64 {
+    pub(crate) fn velocity_sign(&self, axis: usize, theta: f64) -> f64 {
         let v = if axis == 0 { -theta.sin() } else { theta.cos() };
         sign(self.sense() * v)
     }
@@ -48,7 +48,7 @@ fn sign(x: f64) -> f64 {
 }
 
 /// An angle wrapped to (−π, π].
-pub fn wrap(angle: f64) -> f64 {
+pub(crate) fn wrap(angle: f64) -> f64 {
     let w = angle.rem_euclid(TAU);
     if w > PI {
         w - TAU
@@ -60,7 +60,7 @@ pub fn wrap(angle: f64) -> f64 {
 /// A reversal point of an in-plane axis: where it stops and turns, at the extremes of the
 /// circle. `axis` 0 = a (θ = 0: side `+`, θ = π: side `−`), 1 = b (θ = π/2: `+`, 3π/2: `−`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Crossing {
+pub(crate) struct Crossing {
     /// In-plane axis index: 0 = a, 1 = b.
     pub axis: usize,
     /// True at the axis' positive extreme.
@@ -69,7 +69,7 @@ pub struct Crossing {
 
 impl Crossing {
     /// The four reversal points in the order a+, a−, b+, b−.
-    pub const ALL: [Crossing; 4] = [
+    pub(crate) const ALL: [Crossing; 4] = [
         Crossing {
             axis: 0,
             positive: true,
@@ -89,7 +89,7 @@ impl Crossing {
     ];
 
     /// The nominal angle θ_c of the reversal.
-    pub fn angle(self) -> f64 {
+    pub(crate) fn angle(self) -> f64 {
         let base = if self.axis == 0 { 0.0 } else { FRAC_PI_2 };
         if self.positive {
             base
@@ -99,7 +99,7 @@ impl Crossing {
     }
 
     /// The outward unit n_c at the reversal (along the reversing axis).
-    pub fn outward(self) -> [f64; 2] {
+    pub(crate) fn outward(self) -> [f64; 2] {
         let s = if self.positive { 1.0 } else { -1.0 };
         if self.axis == 0 {
             [s, 0.0]
@@ -117,7 +117,7 @@ impl Crossing {
 /// One column of the in-plane design: a unit value of it displaces the path by
 /// [`InPlane::vector`] µm.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum InPlane {
+pub(crate) enum InPlane {
     /// A constant shift along a (µm).
     CentreA,
     /// A constant shift along b (µm).
@@ -157,7 +157,7 @@ pub enum InPlane {
 
 impl InPlane {
     /// The displacement (a, b), µm, of a unit value of the column at nominal angle θ.
-    pub fn vector(&self, circle: &Circle, theta: f64) -> [f64; 2] {
+    pub(crate) fn vector(&self, circle: &Circle, theta: f64) -> [f64; 2] {
         let (s, c) = theta.sin_cos();
         let r_m = circle.radius_mm * 1e-3;
         match *self {
@@ -220,7 +220,7 @@ impl InPlane {
 /// One column of the out-of-plane design: a unit value moves the path by
 /// [`Normal::value`] µm along the plane's normal.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Normal {
+pub(crate) enum Normal {
     /// A constant offset (µm).
     Offset,
     /// A tilt of the path's plane, µm/m: r cos θ (false) or r sin θ (true).
@@ -233,7 +233,7 @@ pub enum Normal {
 
 impl Normal {
     /// The normal displacement, µm, of a unit value of the column at θ.
-    pub fn value(&self, circle: &Circle, theta: f64) -> f64 {
+    pub(crate) fn value(&self, circle: &Circle, theta: f64) -> f64 {
         let r_m = circle.radius_mm * 1e-3;
         match *self {
             Normal::Offset => 1.0,

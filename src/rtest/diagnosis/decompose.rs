@@ -18,7 +18,7 @@ use crate::rtest::lstsq::{lstsq, Lstsq};
 
 /// A solved design: coefficients and their covariance.
 #[derive(Debug, Clone)]
-pub struct Solved {
+pub(crate) struct Solved {
     /// Coefficient per column.
     pub coef: Vec<f64>,
     /// Covariance of the coefficients, s² (XᵀWX)⁻¹.
@@ -35,7 +35,7 @@ impl Solved {
     }
 
     /// Standard error of the linear combination Σ wᵢ coef[colᵢ]: √(wᵀ Σ w).
-    pub fn std_err_of(&self, cols: &[usize], weights: &[f64]) -> f64 {
+    pub(crate) fn std_err_of(&self, cols: &[usize], weights: &[f64]) -> f64 {
         let mut var = 0.0;
         for (i, &ci) in cols.iter().enumerate() {
             for (j, &cj) in cols.iter().enumerate() {
@@ -48,7 +48,7 @@ impl Solved {
 
 /// The in-plane design evaluated at the samples: radial rows and tangential rows.
 #[derive(Debug, Clone)]
-pub struct InPlaneDesign {
+pub(crate) struct InPlaneDesign {
     /// Radial projection of every column, n × p.
     pub radial: DMatrix<f64>,
     /// Tangential projection of every column, n × p.
@@ -57,7 +57,7 @@ pub struct InPlaneDesign {
 
 impl InPlaneDesign {
     /// The design of `columns` at the nominal angles `theta`.
-    pub fn new(columns: &[InPlane], circle: &Circle, theta: &[f64]) -> Self {
+    pub(crate) fn new(columns: &[InPlane], circle: &Circle, theta: &[f64]) -> Self {
         let n = theta.len();
         let p = columns.len();
         let mut radial = DMatrix::zeros(n, p);
@@ -74,7 +74,7 @@ impl InPlaneDesign {
     }
 
     /// The radial and tangential deviation, µm, of the columns `cols` at values `coef[col]`.
-    pub fn model(&self, coef: &[f64], cols: &[usize]) -> [Vec<f64>; 2] {
+    pub(crate) fn model(&self, coef: &[f64], cols: &[usize]) -> [Vec<f64>; 2] {
         [&self.radial, &self.tangential].map(|x| {
             (0..x.nrows())
                 .map(|i| cols.iter().map(|&j| x[(i, j)] * coef[j]).sum())
@@ -85,7 +85,7 @@ impl InPlaneDesign {
 
 /// Residual RMS per block and the weighted fit of the in-plane rows; `None` when the design
 /// is rank deficient.
-pub fn solve_in_plane(
+pub(crate) fn solve_in_plane(
     design: &InPlaneDesign,
     radial_um: &[f64],
     tangential_um: &[f64],
@@ -130,20 +130,20 @@ pub fn solve_in_plane(
 }
 
 /// The out-of-plane design of `columns` at `theta`, n × q.
-pub fn normal_design(columns: &[Normal], circle: &Circle, theta: &[f64]) -> DMatrix<f64> {
+pub(crate) fn normal_design(columns: &[Normal], circle: &Circle, theta: &[f64]) -> DMatrix<f64> {
     DMatrix::from_fn(theta.len(), columns.len(), |i, j| {
         columns[j].value(circle, theta[i])
     })
 }
 
 /// Ordinary least squares of the normal deviation; `None` when rank deficient.
-pub fn solve_normal(design: &DMatrix<f64>, normal_um: &[f64]) -> Option<Solved> {
+pub(crate) fn solve_normal(design: &DMatrix<f64>, normal_um: &[f64]) -> Option<Solved> {
     let y = DMatrix::from_column_slice(normal_um.len(), 1, normal_um);
     Some(Solved::from_lstsq(&lstsq(design.clone(), y)?))
 }
 
 /// The normal deviation, µm, of the columns `cols` at values `coef[col]`.
-pub fn normal_model(design: &DMatrix<f64>, coef: &[f64], cols: &[usize]) -> Vec<f64> {
+pub(crate) fn normal_model(design: &DMatrix<f64>, coef: &[f64], cols: &[usize]) -> Vec<f64> {
     (0..design.nrows())
         .map(|i| cols.iter().map(|&j| design[(i, j)] * coef[j]).sum())
         .collect()
@@ -153,7 +153,7 @@ pub fn normal_model(design: &DMatrix<f64>, coef: &[f64], cols: &[usize]) -> Vec<
 /// tangential deviations (µm): the points (r + e_r)·u(θ) + e_t·t(θ), about their
 /// least-squares centre ([`crate::rtest::iso230::path_figures`], as every path of a test). 0 where no centre
 /// can be fitted.
-pub fn circular_deviation(radius_mm: f64, theta: &[f64], dev: [&[f64]; 2]) -> f64 {
+pub(crate) fn circular_deviation(radius_mm: f64, theta: &[f64], dev: [&[f64]; 2]) -> f64 {
     let n = theta.len();
     let (mut a, mut b) = (Vec::with_capacity(n), Vec::with_capacity(n));
     for i in 0..n {
@@ -167,7 +167,7 @@ pub fn circular_deviation(radius_mm: f64, theta: &[f64], dev: [&[f64]; 2]) -> f6
 }
 
 /// Peak-to-valley of a series, µm.
-pub fn range(v: &[f64]) -> f64 {
+pub(crate) fn range(v: &[f64]) -> f64 {
     let (lo, hi) = v
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &x| {
@@ -181,7 +181,7 @@ pub fn range(v: &[f64]) -> f64 {
 }
 
 /// Root mean square, µm.
-pub fn rms(v: &[f64]) -> f64 {
+pub(crate) fn rms(v: &[f64]) -> f64 {
     if v.is_empty() {
         return 0.0;
     }

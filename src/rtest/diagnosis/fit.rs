@@ -12,7 +12,7 @@ use crate::axes::Plane;
 
 /// A source's deviation over the steady revolutions, µm.
 #[derive(Debug, Clone, Default)]
-pub struct Deviation {
+pub(super) struct Deviation {
     /// Radial.
     pub radial_um: Vec<f64>,
     /// Tangential (ccw positive).
@@ -23,7 +23,7 @@ pub struct Deviation {
 
 impl Deviation {
     /// Empty, room for `n` samples.
-    pub fn with_capacity(n: usize) -> Self {
+    pub(super) fn with_capacity(n: usize) -> Self {
         Deviation {
             radial_um: Vec::with_capacity(n),
             tangential_um: Vec::with_capacity(n),
@@ -42,7 +42,7 @@ const DROP_ORDER: [Family; 5] = [
 ];
 
 /// Decomposes one source; `None` when even the core terms have no unique solution.
-pub fn fit_source(
+pub(super) fn fit_source(
     source: Source,
     plane: Plane,
     circle: &Circle,

@@ -49,11 +49,11 @@ use super::normalise::{normalise, unwrapped_phase, Normalised};
 use super::{CircleSeries, EvalOptions};
 use crate::axes::{Axis, Direction, Plane};
 
-pub mod basis;
-pub mod decompose;
+pub(crate) mod basis;
+pub(crate) mod decompose;
 mod fit;
-pub mod separate;
-pub mod terms;
+pub(crate) mod separate;
+pub(crate) mod terms;
 pub mod tolerance;
 
 pub use separate::{separate, GroupSeparation};

@@ -7,11 +7,11 @@ use super::DiagnosisOptions;
 use crate::axes::{Axis, Plane};
 
 /// Micrometres.
-pub const UM: &str = "um";
+pub(crate) const UM: &str = "um";
 /// Micrometres per metre (µrad).
-pub const UM_PER_M: &str = "um_per_m";
+pub(crate) const UM_PER_M: &str = "um_per_m";
 /// Milliseconds.
-pub const MS: &str = "ms";
+pub(crate) const MS: &str = "ms";
 
 /// Terms of the tangential reference: fitted in every source, reported only for the structure.
 /// The nominal angle θ(t) is fitted to the internal path, so that a rotation or a speed of
@@ -19,11 +19,11 @@ pub const MS: &str = "ms";
 /// there is the straight line's bias (a harmonic of the phase tilts a line through it), not
 /// an error of the machine. In external − internal they are errors: a rotation of the TCP
 /// against the scales, a clock of the R-Test running at another rate.
-pub const REFERENCE: [&str; 2] = ["rotation", "feed_deviation"];
+pub(crate) const REFERENCE: [&str; 2] = ["rotation", "feed_deviation"];
 
 /// How a term's value follows from its columns' coefficients.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Combine {
+pub(crate) enum Combine {
     /// The coefficient of one column.
     One,
     /// The mean of the two reversal points' coefficients (each reported on its own too).
@@ -34,7 +34,7 @@ pub enum Combine {
 
 /// A family of terms the fit may drop, last first, when the design is rank deficient.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
-pub enum Family {
+pub(crate) enum Family {
     /// Always fitted.
     Core,
     /// Lateral play.
@@ -49,7 +49,7 @@ pub enum Family {
 
 /// One named term of the design.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Spec {
+pub(crate) struct Spec {
     /// CONTRACT.md name, e.g. `backlash_x`.
     pub name: String,
     /// Unit of the value.
@@ -68,7 +68,11 @@ pub struct Spec {
 type AtReversal = fn(Crossing) -> InPlane;
 
 /// The in-plane columns and terms of `plane` under `opts`, families up to `keep` included.
-pub fn in_plane(plane: Plane, opts: &DiagnosisOptions, keep: Family) -> (Vec<InPlane>, Vec<Spec>) {
+pub(crate) fn in_plane(
+    plane: Plane,
+    opts: &DiagnosisOptions,
+    keep: Family,
+) -> (Vec<InPlane>, Vec<Spec>) {
     let (a, b) = plane.axes();
     let axes = [a, b];
     let mut cols = Vec::new();
@@ -165,7 +169,7 @@ pub fn in_plane(plane: Plane, opts: &DiagnosisOptions, keep: Family) -> (Vec<InP
 }
 
 /// The out-of-plane columns and terms of `plane`.
-pub fn normal(plane: Plane) -> (Vec<Normal>, Vec<Spec>) {
+pub(crate) fn normal(plane: Plane) -> (Vec<Normal>, Vec<Spec>) {
     let (a, b) = plane.axes();
     let k = plane.normal();
     let cols = vec![
