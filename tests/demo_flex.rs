@@ -19,9 +19,9 @@ use common::{machine as load, root, run, Scratch};
 const TRUTH: &str = "measurements/demo-vmc-flex/generator/demo-vmc-flex-true.toml";
 
 /// `eij identify` of `machine` on pos-a and pos-b, validated on pos-c, without the ranking of
-/// candidate tests: (exit status 0, the report JSON).
+/// candidate tests, the stiffness table written to `st.csv`: (exit status 0, the report JSON).
 fn identify(machine: &str, s: &Scratch) -> (bool, Value) {
-    let (out, report) = (s.s("id.toml"), s.s("id.json"));
+    let (out, report, table) = (s.s("id.toml"), s.s("id.json"), s.s("st.csv"));
     let r = run(&[
         "identify",
         "--machine",
@@ -37,6 +37,8 @@ fn identify(machine: &str, s: &Scratch) -> (bool, Value) {
         &out,
         "--report",
         &report,
+        "--stiffness-out",
+        &table,
     ]);
     let json = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
     (r.ok, json)
@@ -72,6 +74,99 @@ fn the_flexible_demo_recovers_its_truth_and_predicts_the_third_circle_centre() {
     let v = &json["validation"];
     assert_eq!(v["values"].as_u64(), Some(108));
     assert_eq!(v["passed"].as_bool(), Some(true), "{v}");
+    // The identified stiffness table: the column's row carries its factor and standard error.
+    let (header, rows) = table(&s.s("st.csv"));
+    assert_eq!(header.len(), 11, "{header:?}");
+    let column = &rows[rows.len() - 1];
+    let p = parameters
+        .iter()
+        .find(|p| p["name"] == "column.stiffness")
+        .unwrap();
+    assert_eq!(column["element"], "body");
+    assert_eq!(column["parameter"], "column.stiffness");
+    assert_eq!(
+        column["factor"].parse::<f64>().unwrap(),
+        p["identified"].as_f64().unwrap()
+    );
+    assert_eq!(
+        column["factor_std_err"].parse::<f64>().unwrap(),
+        p["std_err"].as_f64().unwrap()
+    );
+}
+
+/// A CSV table: its header and rows as column → cell.
+fn table(path: &str) -> (Vec<String>, Vec<std::collections::BTreeMap<String, String>>) {
+    let mut r = csv::Reader::from_path(path).unwrap();
+    let header: Vec<String> = r.headers().unwrap().iter().map(String::from).collect();
+    let rows = r
+        .records()
+        .map(|rec| {
+            header
+                .iter()
+                .cloned()
+                .zip(rec.unwrap().iter().map(String::from))
+                .collect()
+        })
+        .collect();
+    (header, rows)
+}
+
+#[test]
+fn the_stiffness_table_has_a_row_for_the_elastic_column() {
+    let s = Scratch::new("demo-flex-stiffness");
+    let (plain, soft) = (s.s("flex.csv"), s.s("truth.csv"));
+    let args = |machine: &str, out: &str| {
+        assert!(
+            run(&["stiffness", "--machine", machine, "--out", out]).ok,
+            "{machine}"
+        );
+    };
+    args("machines/demo-vmc-flex.toml", &plain);
+    args(TRUTH, &soft);
+    let (header, rows) = table(&plain);
+    let mut want: Vec<String> = eij::machine::stiffness::COLUMNS.map(String::from).to_vec();
+    want.push("first_frequency_hz".into());
+    assert_eq!(header, want);
+    assert_eq!(rows.len(), 16, "15 axis rows and the column");
+    let column = &rows[15];
+    for (k, v) in [
+        ("axis", "column"),
+        ("element", "body"),
+        ("direction", "all"),
+        ("count", "1"),
+        ("file_n_per_um", ""),
+        ("factor", "1"),
+        ("value_n_per_um", ""),
+    ] {
+        assert_eq!(column[k], v, "{k}");
+    }
+    // The first frequency against the FE reduction's own free-free eigenvalues (another route
+    // than the body's eigen-solution of its reduced M and K).
+    let machine = load("demo-vmc-flex.toml");
+    let reduced = machine
+        .bodies()
+        .iter()
+        .find_map(|b| b.elastic())
+        .and_then(|e| {
+            e.model()
+                .as_any()
+                .downcast_ref::<eij::machine::elastic::FeBody>()
+        })
+        .map(|f| f.reduction().reduced.frequencies_hz(1.0)[0])
+        .unwrap();
+    let f1: f64 = column["first_frequency_hz"].parse().unwrap();
+    assert!(
+        (f1 - reduced).abs() < 1e-9 * reduced,
+        "{f1} against {reduced}"
+    );
+    // The truth's column, factor 0.7: the frequency scales by √0.7.
+    let (_, rows) = table(&soft);
+    assert_eq!(rows[15]["factor"], "0.7");
+    let f: f64 = rows[15]["first_frequency_hz"].parse().unwrap();
+    assert!(
+        (f - 0.7f64.sqrt() * f1).abs() < 1e-9 * f1,
+        "{f} against √0.7 × {f1}"
+    );
 }
 
 #[test]

@@ -71,6 +71,19 @@ pub fn text(machine: &Machine, table: &StiffnessTable) -> String {
         }
         s.push('\n');
     }
+    for b in &table.bodies {
+        let std_err = b
+            .factor_std_err
+            .map_or(String::new(), |e| format!(" ± {e:.4}"));
+        let parameter = b
+            .parameter
+            .as_deref()
+            .map_or(String::new(), |p| format!(" ({p})"));
+        s.push_str(&format!(
+            "  {:<14} body: factor {:.4}{std_err}{parameter} on its whole FE stiffness, first elastic frequency {:.1} Hz, {} elastic modes\n",
+            b.body, b.factor, b.first_frequency_hz, b.modes
+        ));
+    }
     let screws: Vec<String> = table
         .rows
         .iter()

@@ -29,6 +29,9 @@ pub(crate) fn table_with_std_err<'a>(
     let mut table = StiffnessTable::of(machine);
     table.identified = true;
     for (p, std_err) in fitted {
+        if let Some(b) = p.body_index() {
+            table.set_body_std_err(&machine.bodies()[b].name, &p.name, std_err);
+        }
         let Some(axis) = p.axis_index().map(|i| machine.axes()[i].axis) else {
             continue;
         };

@@ -95,6 +95,8 @@ pub struct ElasticBody {
     /// Modal damping at stiffness factor 1: D₁ = M Φ diag(2ζω) Φᵀ M over the elastic modes
     /// (Φ mass-normalised), scaled by √factor since ω ∝ √factor.
     damping_unit: Arc<DMatrix<f64>>,
+    /// ω² of the elastic modes at stiffness factor 1, ascending (rigid modes left out).
+    eigenvalues_unit: Arc<Vec<f64>>,
     damping_ratio: f64,
     stiffness_factor: f64,
 }
@@ -164,10 +166,11 @@ impl ElasticBody {
                 "stiffness factor {stiffness_factor} must be > 0"
             )));
         }
-        let damping_unit = modal_damping(m, k, damping_ratio)?;
+        let (damping_unit, eigenvalues_unit) = modal_damping(m, k, damping_ratio)?;
         Ok(ElasticBody {
             model,
             damping_unit: Arc::new(damping_unit),
+            eigenvalues_unit: Arc::new(eigenvalues_unit),
             damping_ratio,
             stiffness_factor,
         })
@@ -193,18 +196,28 @@ impl ElasticBody {
         self.damping_ratio
     }
 
+    /// The body's elastic free-free frequencies at its stiffness factor, Hz, ascending (the
+    /// reduced body alone, rigid modes left out): √(factor · ω²)/2π.
+    pub fn frequencies_hz(&self) -> Vec<f64> {
+        self.eigenvalues_unit
+            .iter()
+            .map(|l| (self.stiffness_factor * l).sqrt() / std::f64::consts::TAU)
+            .collect()
+    }
+
     pub(crate) fn set_stiffness_factor(&mut self, factor: f64) {
         self.stiffness_factor = factor;
     }
 }
 
 /// D = M Φ diag(2ζω) Φᵀ M over the modes of K φ = ω² M φ (Φᵀ M Φ = I), so that Φᵀ D Φ =
-/// diag(2ζω): every mode damped by ζ, the rigid modes (ω = 0) not at all.
+/// diag(2ζω): every mode damped by ζ, the rigid modes (ω = 0) not at all; and the ω² of the
+/// elastic modes, ascending (the six smallest, the rigid modes, left out).
 fn modal_damping(
     m: &DMatrix<f64>,
     k: &DMatrix<f64>,
     zeta: f64,
-) -> Result<DMatrix<f64>, ElasticModelError> {
+) -> Result<(DMatrix<f64>, Vec<f64>), ElasticModelError> {
     let chol = m.clone().cholesky().ok_or_else(|| {
         ElasticModelError::Physics("the mass matrix is not positive definite".into())
     })?;
@@ -227,7 +240,12 @@ fn modal_damping(
     let omega = eig.eigenvalues.map(|w2| 2.0 * zeta * w2.max(0.0).sqrt());
     // With y = Lᵀq the problem is standard; M Φ = L V, so D = L V diag V ᵀ Lᵀ.
     let lv = &l * &eig.eigenvectors;
-    Ok(&lv * DMatrix::from_diagonal(&omega) * lv.transpose())
+    let mut elastic: Vec<f64> = eig.eigenvalues.iter().map(|w2| w2.max(0.0)).collect();
+    elastic.sort_by(f64::total_cmp);
+    Ok((
+        &lv * DMatrix::from_diagonal(&omega) * lv.transpose(),
+        elastic.split_off(6.min(elastic.len())),
+    ))
 }
 
 /// What kind of body, and what that kind carries.

@@ -167,6 +167,27 @@ impl StiffnessRow {
     }
 }
 
+/// An elastic body's row: the factor on its whole FE stiffness (E and G alike) and the first
+/// elastic frequency it gives. In the CSV: `axis` = the body's name, `element` = `body`,
+/// `direction` = `all`, `count` = 1, no N/µm values.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BodyRow {
+    /// The body's name.
+    pub body: String,
+    /// Its `stiffness_factor`.
+    pub factor: f64,
+    /// Its first elastic free-free frequency with the factor (the reduced body alone), Hz.
+    pub first_frequency_hz: f64,
+    /// Elastic coordinates kept.
+    pub modes: usize,
+    /// Standard error of the factor, where identified.
+    #[serde(default)]
+    pub factor_std_err: Option<f64>,
+    /// The identified parameter that set the factor (`column.stiffness`), if any.
+    #[serde(default)]
+    pub parameter: Option<String>,
+}
+
 /// The stiffness set of a machine.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StiffnessTable {
@@ -176,7 +197,13 @@ pub struct StiffnessTable {
     /// Rows, per axis in the machine's order: guideway normal, guideway lateral, screw, nut,
     /// bearing.
     pub rows: Vec<StiffnessRow>,
+    /// One row per elastic body, in the machine's body order.
+    pub bodies: Vec<BodyRow>,
 }
+
+/// The columns a table of a machine with elastic bodies adds (`factor_std_err` on identified
+/// tables only).
+pub const BODY_COLUMNS: [&str; 2] = ["first_frequency_hz", "factor_std_err"];
 
 /// The columns every table has (CONTRACT.md).
 pub(crate) const COLUMNS: [&str; 7] = [
@@ -298,9 +325,35 @@ impl StiffnessTable {
                 d.reduction,
             ));
         }
+        let bodies = machine
+            .bodies
+            .iter()
+            .filter_map(|b| {
+                let e = b.elastic()?;
+                Some(BodyRow {
+                    body: b.name.clone(),
+                    factor: e.stiffness_factor(),
+                    first_frequency_hz: e.frequencies_hz().first().copied().unwrap_or(f64::NAN),
+                    modes: e.modes(),
+                    factor_std_err: None,
+                    parameter: None,
+                })
+            })
+            .collect();
         StiffnessTable {
             identified: false,
             rows,
+            bodies,
+        }
+    }
+
+    /// Marks the table as identified and gives the row of elastic body `body` the parameter
+    /// that set its factor and the factor's standard error.
+    pub fn set_body_std_err(&mut self, body: &str, parameter: &str, std_err: Option<f64>) {
+        self.identified = true;
+        for r in self.bodies.iter_mut().filter(|r| r.body == body) {
+            r.factor_std_err = std_err;
+            r.parameter = Some(parameter.to_string());
         }
     }
 
@@ -332,6 +385,13 @@ impl StiffnessTable {
         if self.identified {
             header.extend(IDENTIFIED_COLUMNS);
         }
+        let with_bodies = !self.bodies.is_empty();
+        if with_bodies {
+            header.push(BODY_COLUMNS[0]);
+            if self.identified {
+                header.push(BODY_COLUMNS[1]);
+            }
+        }
         // Writing into a Vec cannot fail.
         let _ = w.write_record(&header);
         for r in &self.rows {
@@ -347,6 +407,33 @@ impl StiffnessTable {
             if self.identified {
                 record.push(r.std_err_n_per_um.map_or(String::new(), |s| s.to_string()));
                 record.push(r.parameter.clone().unwrap_or_default());
+            }
+            if with_bodies {
+                record.push(String::new());
+                if self.identified {
+                    let factor = r.std_err_n_per_um.map(|s| s / r.file_n_per_um);
+                    record.push(factor.map_or(String::new(), |s| s.to_string()));
+                }
+            }
+            let _ = w.write_record(&record);
+        }
+        for b in &self.bodies {
+            let mut record = vec![
+                b.body.clone(),
+                "body".into(),
+                "all".into(),
+                "1".into(),
+                String::new(),
+                b.factor.to_string(),
+                String::new(),
+            ];
+            if self.identified {
+                record.push(String::new());
+                record.push(b.parameter.clone().unwrap_or_default());
+            }
+            record.push(b.first_frequency_hz.to_string());
+            if self.identified {
+                record.push(b.factor_std_err.map_or(String::new(), |s| s.to_string()));
             }
             let _ = w.write_record(&record);
         }
