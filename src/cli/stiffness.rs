@@ -111,7 +111,7 @@ pub fn text(machine: &Machine, table: &StiffnessTable) -> String {
         .collect();
     if !elastic.is_empty() {
         s.push_str(
-            "\nElastic bodies (the factor scales the body's whole FE stiffness, E and G alike; not in the CSV):\n  ",
+            "\nElastic bodies (the factor scales the body's whole FE stiffness, E and G alike; their rows are in the CSV as element `body`):\n  ",
         );
         s.push_str(&elastic.join("\n  "));
         s.push('\n');
