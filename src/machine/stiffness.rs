@@ -205,8 +205,8 @@ pub struct StiffnessTable {
 /// tables only).
 pub const BODY_COLUMNS: [&str; 2] = ["first_frequency_hz", "factor_std_err"];
 
-/// The columns every table has (CONTRACT.md).
-pub(crate) const COLUMNS: [&str; 7] = [
+/// The columns every stiffness table has (docs/stiffness-table.md).
+pub const COLUMNS: [&str; 7] = [
     "axis",
     "element",
     "direction",

@@ -16,7 +16,7 @@ use crate::sim::Run;
 const MAX_POINTS: usize = 3000;
 
 /// A peak per axis, µm.
-pub type AxisPeaks = Vec<(Axis, f64)>;
+pub(crate) type AxisPeaks = Vec<(Axis, f64)>;
 
 /// A positioning move of one axis, in the units of the move CSV.
 #[derive(Debug, Clone, PartialEq)]
