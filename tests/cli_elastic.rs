@@ -186,7 +186,13 @@ fn every_command(machine: &str, tag: &str) {
         "stiffness --machine {} --out {} -q",
         &[machine, &s.s("k.csv")],
     );
-    assert_eq!(rows(&s.path("k.csv")), 15);
+    // 15 catalogue elements + one row (element `body`) for the elastic column.
+    assert_eq!(rows(&s.path("k.csv")), 16);
+    let table = std::fs::read_to_string(s.path("k.csv")).unwrap();
+    assert!(
+        table.lines().any(|l| l.starts_with("column,body,")),
+        "{table}"
+    );
     let text = ok(&["stiffness", "--machine", machine]);
     assert!(text.contains("column"), "{text}");
 }
