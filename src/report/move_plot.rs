@@ -15,9 +15,6 @@ use crate::sim::Run;
 /// Points per polyline at most.
 const MAX_POINTS: usize = 3000;
 
-/// A peak per axis, µm.
-pub(crate) type AxisPeaks = Vec<(Axis, f64)>;
-
 /// A positioning move of one axis, in the units of the move CSV.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MoveData {
@@ -45,10 +42,6 @@ pub struct MoveData {
     /// states its peak velocity, acceleration and jerk (the numbers `eij simulate move`
     /// prints) instead of estimates from the samples.
     pub plan: Option<JerkLimitedMove>,
-    /// The TCP's deviation from the nominal path (TCP − set) of the other axes in the same move
-    /// simulated without the compensation, µm (`eij simulate move --compensation` runs both):
-    /// drawn as "without compensation" in place of the structural cross-talk.
-    pub uncompensated_um: Vec<(Axis, Vec<f64>)>,
 }
 
 impl MoveData {
@@ -145,7 +138,6 @@ impl MoveData {
             axis,
             compensated_um,
             plan: None,
-            uncompensated_um: Vec::new(),
             set_mm: need("set_mm")?,
             int_mm: need("int_mm")?,
             acc_set_m_s2: need("acc_set_m_s2")?,
@@ -194,7 +186,6 @@ impl MoveData {
             cross_talk_um,
             compensated_um: Vec::new(),
             plan: None,
-            uncompensated_um: Vec::new(),
             source,
         })
     }
@@ -256,22 +247,6 @@ impl MoveData {
     /// Signed distance of the set position, mm.
     pub fn distance_mm(&self) -> f64 {
         self.set_mm.last().copied().unwrap_or(0.0) - self.set_mm.first().copied().unwrap_or(0.0)
-    }
-
-    /// Largest |TCP − nominal path| per other axis, µm, with the compensation (empty if the
-    /// move has none) and without it (the uncompensated run, else the structural cross-talk).
-    pub fn peak_path_deviation_um(&self) -> (AxisPeaks, AxisPeaks) {
-        let peaks = |v: &[(Axis, Vec<f64>)]| -> AxisPeaks {
-            v.iter()
-                .map(|(b, d)| (*b, d.iter().fold(0.0, |m: f64, x| m.max(x.abs()))))
-                .collect()
-        };
-        let without = if self.uncompensated_um.is_empty() {
-            &self.cross_talk_um
-        } else {
-            &self.uncompensated_um
-        };
-        (peaks(&self.compensated_um), peaks(without))
     }
 
     /// Largest |set acceleration|, m/s².
@@ -363,36 +338,30 @@ pub fn move_svg(data: &MoveData, cond: &Conditions) -> Result<String, ReportErro
         ),
         (
             "deviation / µm".to_string(),
-            if data.uncompensated_um.is_empty() {
-                &data.cross_talk_um
-            } else {
-                &data.uncompensated_um
-            }
-            .iter()
-            .zip([svg::EXTERNAL, svg::SECOND])
-            .map(|((b, v), c)| {
-                let label = if !data.uncompensated_um.is_empty() {
-                    format!("d{b} without compensation (TCP − nominal path)")
-                } else if data.compensated_um.is_empty() {
-                    format!("d{b} = {b}_ext − {b}_int")
-                } else {
-                    format!("d{b} without compensation ({b}_ext − {b}_int)")
-                };
-                (label, c, series(v))
-            })
-            .chain(
-                data.compensated_um
-                    .iter()
-                    .zip([svg::SET, svg::INTERNAL])
-                    .map(|((b, v), c)| {
-                        (
-                            format!("d{b} with compensation (TCP − nominal path)"),
-                            c,
-                            series(v),
-                        )
-                    }),
-            )
-            .collect(),
+            data.cross_talk_um
+                .iter()
+                .zip([svg::EXTERNAL, svg::SECOND])
+                .map(|((b, v), c)| {
+                    let label = if data.compensated_um.is_empty() {
+                        format!("d{b} = {b}_ext − {b}_int")
+                    } else {
+                        format!("d{b} without compensation ({b}_ext − {b}_int)")
+                    };
+                    (label, c, series(v))
+                })
+                .chain(
+                    data.compensated_um
+                        .iter()
+                        .zip([svg::SET, svg::INTERNAL])
+                        .map(|((b, v), c)| {
+                            (
+                                format!("d{b} with compensation ({b}_ext − {b}_set)"),
+                                c,
+                                series(v),
+                            )
+                        }),
+                )
+                .collect(),
             if data.compensated_um.is_empty() {
                 vec![
                     format!("cross-talk: TCP deviation of"),
