@@ -11,7 +11,8 @@
 //! The trajectory alignment ([`align`]) minimises the mean square distance between the
 //! external and the internal path over the whole overlap, ramps and rests included, so that it
 //! has one minimum and not one per revolution. It cannot tell a clock offset from the
-//! structural deviation itself: on a steady circle a residual offset δ adds δ·v, and v_a has
+//! structural deviation itself: on a steady circle a residual offset δ (internal minus external
+//! clock; negative for late external readings) adds δ·v, and v_a has
 //! the shape of the acceleration of the other axis, so the alignment absorbs the antisymmetric
 //! in-plane cross-talk (E_ab − E_ba)·ω/2 (tens of µs). [`super::clock_fit`] separates the two
 //! across tests.
