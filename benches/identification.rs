@@ -1,7 +1,10 @@
 //! The full demo identification (36 R-Test circles, 6 guideway factors), harmonic and time
 //! domain, each with and without the ranking of candidate tests (experiment design, always
-//! harmonic). Each sample is a whole identification after the measured files are read: expect
-//! a few seconds (harmonic) and about a minute (time domain) for the ten samples.
+//! harmonic); and the flexible demo's (`machines/demo-vmc-flex.toml`, elastic column; 36
+//! circles of `measurements/demo-vmc-flex/` pos-a and pos-b, 7 parameters with
+//! `column.stiffness`), harmonic with and without the ranking. Each sample is a whole
+//! identification after the measured files are read: expect a few seconds (harmonic) and about
+//! a minute (time domain) for the ten samples.
 //!
 //! Run: `cargo bench --bench identification`
 
@@ -12,30 +15,60 @@ use eij::machine::Machine;
 use eij::predict::{SimSettings, SolverKind};
 use std::path::Path;
 
+const HARMONIC: [(&str, SolverKind, bool); 2] = [
+    ("harmonic", SolverKind::Harmonic, true),
+    (
+        "harmonic, without the ranking of candidate tests",
+        SolverKind::Harmonic,
+        false,
+    ),
+];
+
 fn bench(c: &mut Criterion) {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let machine = Machine::from_file(&root.join("machines/demo-vmc.toml")).unwrap();
-    let tests = load(
-        &[root.join("measurements/demo-vmc")],
-        &MeasuredOptions::default(),
-    )
-    .unwrap();
-    let mut group = c.benchmark_group("demo identification (36 tests, 6 parameters)");
-    group.sample_size(10);
-    for (name, solver, design) in [
-        ("harmonic", SolverKind::Harmonic, true),
-        (
-            "harmonic, without the ranking of candidate tests",
-            SolverKind::Harmonic,
-            false,
-        ),
+    let time = [
         ("time domain", SolverKind::Time, true),
         (
             "time domain, without the ranking of candidate tests",
             SolverKind::Time,
             false,
         ),
-    ] {
+    ];
+    let all: Vec<_> = HARMONIC.into_iter().chain(time).collect();
+    run(
+        c,
+        "demo identification (36 tests, 6 parameters)",
+        "machines/demo-vmc.toml",
+        &["measurements/demo-vmc"],
+        &all,
+    );
+    run(
+        c,
+        "flexible demo identification (36 tests, 7 parameters)",
+        "machines/demo-vmc-flex.toml",
+        &[
+            "measurements/demo-vmc-flex/pos-a",
+            "measurements/demo-vmc-flex/pos-b",
+        ],
+        &HARMONIC,
+    );
+}
+
+/// One group: the identification of `machine` from `measured` (default parameter set) with each
+/// of `cases` (name, solver, ranking of candidate tests).
+fn run(
+    c: &mut Criterion,
+    group: &str,
+    machine: &str,
+    measured: &[&str],
+    cases: &[(&str, SolverKind, bool)],
+) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let machine = Machine::from_file(&root.join(machine)).unwrap();
+    let folders: Vec<_> = measured.iter().map(|m| root.join(m)).collect();
+    let tests = load(&folders, &MeasuredOptions::default()).unwrap();
+    let mut group = c.benchmark_group(group);
+    group.sample_size(10);
+    for &(name, solver, design) in cases {
         let settings = Settings {
             simulation: SimSettings {
                 solver,

@@ -24,6 +24,22 @@ fn demo() -> Machine {
         .unwrap()
 }
 
+/// The flexible demo (`machines/demo-vmc-flex.toml`) with its beam column in 16 elements and 20
+/// fixed-interface modes kept (issue 27's speed check: the harmonic circle with an elastic
+/// column of 20 modes against one complex LU of its closed loop).
+fn elastic_demo() -> Machine {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("machines/demo-vmc-flex.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let text = text
+        .replacen("elements = 5\n", "elements = 16\n", 1)
+        .replacen("modes = 0 ", "modes = 20 ", 1);
+    let m = Machine::from_toml_str(&text, &path.display().to_string()).unwrap();
+    let column = m.bodies().iter().position(|b| b.name == "column").unwrap();
+    let kept = m.fe_summary(column).unwrap().unwrap().modes;
+    assert_eq!(kept, 20, "fixed-interface modes of the column");
+    m
+}
+
 /// A synthetic machine: a chain of `n` bodies of 500 kg, each on four joints on the previous
 /// one, with an X slide and a Y cross slide on it, each on guideways with a ball screw
 /// (6·n + 14 DOF, 12·n + 34 closed-loop states).
@@ -112,6 +128,9 @@ fn bench(c: &mut Criterion) {
         },
     );
     harmonic_circle(c, "demo", &cl);
+    let elastic = elastic_demo();
+    let cl_elastic = ClosedLoop::new(&elastic, &elastic.reference_pose()).unwrap();
+    harmonic_circle(c, "demo, elastic column of 20 modes", &cl_elastic);
 
     let mut group = c.benchmark_group("bodies");
     for n in [1usize, 4, 16, 32] {

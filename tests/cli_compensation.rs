@@ -52,6 +52,13 @@ fn columns(path: &str) -> BTreeMap<String, Vec<f64>> {
 
 /// The paper's 20 mm Z move (30 000 mm/min, 10 m/s², 250 m/s³) at `pos`, with extra options.
 fn z_move(out: &str, pos: &str, extra: &[&str]) -> BTreeMap<String, Vec<f64>> {
+    let r = z_move_run(out, pos, extra);
+    assert!(r.ok, "{}", r.stderr);
+    columns(out)
+}
+
+/// The Z move of [`z_move`], its console output.
+fn z_move_run(out: &str, pos: &str, extra: &[&str]) -> common::Run {
     let (_, machine, _) = identified();
     let mut args = vec![
         "simulate",
@@ -76,9 +83,7 @@ fn z_move(out: &str, pos: &str, extra: &[&str]) -> BTreeMap<String, Vec<f64>> {
         out,
     ];
     args.extend_from_slice(extra);
-    let r = run(&args);
-    assert!(r.ok, "{}", r.stderr);
-    columns(out)
+    run(&args)
 }
 
 /// Largest |TCP − nominal path| of direction `a` over the move, µm.
@@ -342,4 +347,66 @@ fn the_report_shows_the_compensated_move_and_move_against_circle_eij() {
         .filter(|t| t.contains("with compensation"))
         .count();
     assert_eq!(with, 1, "one move figure shows the compensated deviation");
+}
+
+/// The numbers of `text` (a header line or a console line) in order, as written.
+fn numbers(text: &str) -> Vec<f64> {
+    text.split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-'))
+        .filter_map(|w| w.parse().ok())
+        .collect()
+}
+
+#[test]
+fn the_move_plots_header_states_the_planned_profile_the_console_prints() {
+    // Issue 29 item 3: with a compensation, the set acceleration fed to the model holds the
+    // correction's second difference; the header's peaks came from those samples (8.475 m/s²,
+    // jerk ≈ 7936 m/s³). They must be the planned move's: what the console prints, and the
+    // requested jerk.
+    let (s, _, table) = identified();
+    let (csv, svg) = (s.s("head.csv"), s.s("head.svg"));
+    let r = z_move_run(&csv, "0,0,0", &["--compensation", table, "--plot", &svg]);
+    assert!(r.ok, "{}", r.stderr);
+    let console = r
+        .stderr
+        .lines()
+        .find(|l| l.contains("peak set acceleration"))
+        .unwrap_or_else(|| panic!("no move line in {}", r.stderr));
+    // "move z: 20.000 mm, peak velocity 0.2924 m/s, peak set acceleration 8.550 m/s², 0.1368 s"
+    let c = numbers(console.split("move z:").nth(1).unwrap());
+    let (v, a) = (c[1], c[2]);
+    // Independent: the paper's 20 mm at 250 m/s³ never reaches 10 m/s², a = (D·j²/2)^(1/3).
+    assert!(
+        (a - (0.02f64 * 250.0 * 250.0 / 2.0).cbrt()).abs() < 5e-4,
+        "{console}"
+    );
+    let text = std::fs::read_to_string(&svg).unwrap();
+    let header = text
+        .split('>')
+        .find(|t| t.contains("peak set velocity"))
+        .unwrap_or_else(|| panic!("no header line in {svg}"));
+    let h = numbers(header.split('<').next().unwrap());
+    // distance, velocity, feed, acceleration, jerk
+    assert_eq!(h.len(), 5, "{header}");
+    assert!(
+        !header.contains('≈'),
+        "planned values, not estimates: {header}"
+    );
+    assert!((h[0] - 20.0).abs() < 1e-9, "{header}");
+    assert!((h[1] - v).abs() < 1e-4, "velocity {header} vs {console}");
+    assert!(
+        (h[2] - v * 60_000.0).abs() < 6.0,
+        "feed {header} vs {console}"
+    );
+    assert!(
+        (h[3] - a).abs() < 1e-3,
+        "acceleration {header} vs {console}"
+    );
+    assert_eq!(h[4], 250.0, "{header}");
+    // The set acceleration drawn is the nominal one: the CSV's column (nominal too) never
+    // exceeds the planned peak, the sampled values without spikes.
+    let cols = columns(&csv);
+    let peak = cols["z_acc_set_m_s2"]
+        .iter()
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+    assert!(peak <= a + 1e-3 && peak > a - 0.3, "CSV peak {peak} vs {a}");
 }

@@ -85,7 +85,18 @@ fn measured(truth: &Machine, circles: Vec<CircleTest>) -> Vec<TestCase> {
         .map(|(circle, sim)| TestCase {
             source: format!("synthetic {}", circle.label()),
             circle,
-            measured: eij::EijEstimates::with_std_err(sim, 0.01),
+            measured: sim
+                .into_iter()
+                .map(|(k, value)| {
+                    (
+                        k,
+                        eij::axes::Estimate {
+                            value,
+                            std_err: 0.01,
+                        },
+                    )
+                })
+                .collect(),
             clock: None,
         })
         .collect()

@@ -1,5 +1,5 @@
 //! `eij fe --machine FILE.toml --body NAME [--json]`: an elastic body's FE model and its
-//! reduction (CONTRACT "Flexible bodies"; docs/fe.md).
+//! reduction (docs/fe.md; docs/fe.md).
 
 use super::console::Progress;
 use eij::fe::FeSummary;
@@ -17,7 +17,7 @@ pub struct FeArgs {
     /// The elastic body (a `[[body]]` with `[body.fe]` or `[body.beam]`).
     #[arg(long, value_name = "NAME")]
     body: String,
-    /// Print one JSON object (CONTRACT keys) instead of text.
+    /// Print one JSON object (docs/fe.md keys) instead of text.
     #[arg(long)]
     json: bool,
 }
@@ -91,6 +91,12 @@ fn differences(s: &FeSummary) -> Vec<f64> {
         .collect()
 }
 
+/// `x` rounded to `decimals` for display, without a minus sign on a value that rounds to zero.
+fn tidy(x: f64, decimals: i32) -> f64 {
+    let scale = 10f64.powi(decimals);
+    (x * scale).round() / scale + 0.0
+}
+
 /// A relative difference in per cent for the table: round-off (below 1e-8) shown as 0.
 fn percent(d: f64) -> f64 {
     if d.abs() < 1e-8 {
@@ -134,10 +140,14 @@ fn text(machine: &Machine, raw: &RawBody, s: &FeSummary) -> String {
     let c = s.cog_m;
     t += &format!(
         "  mass {:.3} kg, centre of gravity [{:.4}, {:.4}, {:.4}] m\n  inertia about the centre of gravity, kg·m²:\n",
-        s.mass_kg, c[0], c[1], c[2]
+        s.mass_kg,
+        tidy(c[0], 4),
+        tidy(c[1], 4),
+        tidy(c[2], 4)
     );
     for row in &s.inertia_kg_m2 {
-        t += &format!("    [{:>12.4} {:>12.4} {:>12.4}]\n", row[0], row[1], row[2]);
+        let [a, b, c] = row.map(|x| tidy(x, 4));
+        t += &format!("    [{a:>12.4} {b:>12.4} {c:>12.4}]\n");
     }
     let stations = s.interface_dofs / 6;
     let interface = if s.interface_coordinates == s.interface_dofs {
@@ -187,6 +197,12 @@ fn text(machine: &Machine, raw: &RawBody, s: &FeSummary) -> String {
     }
     t += &format!("{}\n", resolution(s, &d, cutoff_hz(raw)));
     t += "Attachments at the reference position (FE node: weight):\n";
+    let width = s
+        .attachments
+        .iter()
+        .map(|a| a.point.chars().count())
+        .max()
+        .unwrap_or(0);
     for a in &s.attachments {
         let nodes: Vec<String> = a
             .nodes
@@ -194,7 +210,7 @@ fn text(machine: &Machine, raw: &RawBody, s: &FeSummary) -> String {
             .zip(&a.weights)
             .map(|(n, w)| format!("{n}: {w:.3}"))
             .collect();
-        t += &format!("  {:<22} {}\n", a.point, nodes.join(", "));
+        t += &format!("  {:<width$}  {}\n", a.point, nodes.join(", "));
     }
     t
 }

@@ -32,7 +32,7 @@ enum Test {
 struct Common {
     #[command(flatten)]
     machine: MachineArgs,
-    /// Output CSV file (CONTRACT.md columns).
+    /// Output CSV file (docs/commands.md columns).
     #[arg(long, value_name = "FILE.csv")]
     out: PathBuf,
     /// Output sample rate, Hz.
@@ -109,7 +109,7 @@ fn corrections(comp: &Compensated, cl: &ClosedLoop, run: &eij::sim::Run) -> Vec<
 /// What `--plot` draws.
 enum PlotKind {
     Circle { radius_mm: f64 },
-    Move(Axis),
+    Move(JerkLimitedMove),
 }
 
 #[derive(Debug, clap::Args)]
@@ -298,7 +298,14 @@ fn run_move(common: &Common, mv: &JerkLimitedMove) -> anyhow::Result<()> {
     drop(spinner);
     let cl = &segments[0].closed_loop;
     let correction = comp.as_ref().map(|c| corrections(c, cl, &run));
-    write_output_files(common, cl, run, PlotKind::Move(mv.axis), cond, correction)
+    write_output_files(
+        common,
+        cl,
+        run,
+        PlotKind::Move(mv.clone()),
+        cond,
+        correction,
+    )
 }
 
 fn run_setpoint(
@@ -427,8 +434,11 @@ fn write_output_files(
             };
             Some((path, CircleView::new(&series, &eval)?.magnified_svg(&cond)?))
         }
-        (Some(path), PlotKind::Move(axis)) => {
-            let data = MoveData::from_run(cl, &run, axis, cond.source.clone())?;
+        (Some(path), PlotKind::Move(mv)) => {
+            let mut data = MoveData::from_run(cl, &run, mv.axis, cond.source.clone())?.planned(&mv);
+            if let Some(c) = &opts.correction {
+                data = data.nominal(cl, &run, c)?;
+            }
             Some((path, move_svg(&data, &cond)?))
         }
     };

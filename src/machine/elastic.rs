@@ -1,6 +1,6 @@
 //! Elastic bodies from `[body.fe]` and `[body.beam]`: the FE model ([`crate::fe`]) reduced for
 //! the points the machine attaches to the body, and coupled through those attachments
-//! (CONTRACT "Flexible bodies"):
+//! (docs/fe.md):
 //!
 //! * a point fixed on the body (a carriage or the nut on the moving body, joints, the TCP)
 //!   attaches by the contract's rule (nearest 6-DOF node through the lever arm, or an RBE3 patch
@@ -31,7 +31,7 @@ use std::sync::{Arc, Mutex, OnceLock};
 /// Default number of fixed-interface modes where neither `modes` nor `cutoff_hz` is given.
 pub(crate) const DEFAULT_MODES: usize = 20;
 
-/// How far given mass properties may differ from the FE model's (CONTRACT): mass and inertia
+/// How far given mass properties may differ from the FE model's (docs/fe.md): mass and inertia
 /// relative, COG relative to the body's extent.
 const MASS_AGREEMENT: f64 = 0.01;
 
@@ -179,7 +179,7 @@ fn key(source: &Source, settings: &ReductionSettings, attachments: &[Attachment]
 fn model(source: &Source) -> Result<FeModel, fe::FeError> {
     match source {
         Source::Files(_, [m, k, d, n]) => FeModel::from_files(m, k, d, n),
-        Source::Beam(b) => FeModel::beam(&beam(b)),
+        Source::Beam(b) => FeModel::beam(&Beam::from(*b)),
     }
 }
 
@@ -226,20 +226,22 @@ fn reduce(
     Ok(r)
 }
 
-fn beam(b: &RawBeam) -> Beam {
-    Beam {
-        from_m: b.from_m,
-        to_m: b.to_m,
-        elements: b.elements,
-        y_axis: b.y_axis,
-        area_m2: b.area_m2,
-        iy_m4: b.iy_m4,
-        iz_m4: b.iz_m4,
-        torsion_m4: b.torsion_m4,
-        shear_factor: b.shear_factor,
-        youngs_modulus_pa: b.youngs_modulus_pa,
-        shear_modulus_pa: b.shear_modulus_pa,
-        density_kg_m3: b.density_kg_m3,
+impl From<&RawBeam> for Beam {
+    fn from(b: &RawBeam) -> Beam {
+        Beam {
+            from_m: b.from_m,
+            to_m: b.to_m,
+            elements: b.elements,
+            y_axis: b.y_axis,
+            area_m2: b.area_m2,
+            iy_m4: b.iy_m4,
+            iz_m4: b.iz_m4,
+            torsion_m4: b.torsion_m4,
+            shear_factor: b.shear_factor,
+            youngs_modulus_pa: b.youngs_modulus_pa,
+            shear_modulus_pa: b.shear_modulus_pa,
+            density_kg_m3: b.density_kg_m3,
+        }
     }
 }
 
@@ -253,7 +255,7 @@ impl Machine {
         }
     }
 
-    /// `eij fe`'s summary of body `b` (CONTRACT "Flexible bodies"): its FE model, its reduction
+    /// `eij fe`'s summary of body `b` (docs/fe.md): its FE model, its reduction
     /// for this machine's attachments (at the reference position) and, for comparison, the full
     /// model's elastic free-free frequencies (the model read or built again, a sparse
     /// eigensolution of the whole model). Frequencies hold at the body's stiffness factor.
@@ -478,7 +480,7 @@ fn agrees(difference: f64, scale: f64) -> bool {
     difference <= MASS_AGREEMENT * scale
 }
 
-/// Mass, COG and inertia given beside an FE model must agree with it (CONTRACT): mass within
+/// Mass, COG and inertia given beside an FE model must agree with it (docs/fe.md): mass within
 /// 1 %, COG within 1 % of the body's extent, inertia within 1 % of its largest principal value.
 fn check_given_mass(rb: &RawBody, r: &Reduction) -> Result<(), FieldError> {
     let fe = &r.reduced.mass;

@@ -178,7 +178,7 @@ pub struct StiffnessTable {
     pub rows: Vec<StiffnessRow>,
 }
 
-/// The columns every table has (CONTRACT.md).
+/// The columns every table has (docs/commands.md).
 pub(crate) const COLUMNS: [&str; 7] = [
     "axis",
     "element",
@@ -323,7 +323,7 @@ impl StiffnessTable {
         }
     }
 
-    /// The table as CSV (CONTRACT.md columns; an identified table adds `std_err_n_per_um` and
+    /// The table as CSV (docs/commands.md columns; an identified table adds `std_err_n_per_um` and
     /// `parameter`, empty where a factor was not identified). Numbers are written in full
     /// (shortest round-trip form), so two tables of the same stiffness set are equal as text.
     pub fn to_csv(&self) -> Vec<u8> {

@@ -9,6 +9,7 @@ use super::svg::{self, Entry, Mark};
 use super::{short, Conditions, ReportError};
 use crate::axes::Axis;
 use crate::control::ClosedLoop;
+use crate::sim::setpoint::JerkLimitedMove;
 use crate::sim::Run;
 
 /// Points per polyline at most.
@@ -37,6 +38,10 @@ pub struct MoveData {
     /// For a compensated move (`<b>_comp_mm` columns), the TCP's deviation from the nominal
     /// path ext − set of the other axes, µm: what remains with the compensation.
     pub compensated_um: Vec<(Axis, Vec<f64>)>,
+    /// The planned profile of the move, when known ([`MoveData::planned`]): the header then
+    /// states its peak velocity, acceleration and jerk (the numbers `eij simulate move`
+    /// prints) instead of estimates from the samples.
+    pub plan: Option<JerkLimitedMove>,
 }
 
 impl MoveData {
@@ -132,6 +137,7 @@ impl MoveData {
         Ok(MoveData {
             axis,
             compensated_um,
+            plan: None,
             set_mm: need("set_mm")?,
             int_mm: need("int_mm")?,
             acc_set_m_s2: need("acc_set_m_s2")?,
@@ -179,8 +185,63 @@ impl MoveData {
             acc_act_m_s2: get(format!("{axis}_acc_act_m_s2"), false, 1.0)?,
             cross_talk_um,
             compensated_um: Vec::new(),
+            plan: None,
             source,
         })
+    }
+
+    /// The same move with its planned profile (the header's peak values come from it).
+    pub fn planned(mut self, plan: &JerkLimitedMove) -> Self {
+        self.plan = Some(plan.clone());
+        self
+    }
+
+    /// For a run with a compensation: `correction` (laid out like [`Run::inputs`], as
+    /// `Compensated::correction` gives it) is taken off the set points, so that set position
+    /// and set acceleration show the nominal move (as the CSV's `<a>_set_mm` columns do), and
+    /// the TCP's deviation from the nominal path (TCP − nominal set) of the other axes becomes
+    /// [`MoveData::compensated_um`].
+    pub fn nominal(
+        mut self,
+        cl: &ClosedLoop,
+        run: &Run,
+        correction: &[f64],
+    ) -> Result<Self, ReportError> {
+        let nominal = |name: String| -> Option<Vec<f64>> {
+            let i = cl.input(&name)?;
+            Some(
+                run.input(i)
+                    .enumerate()
+                    .map(|(k, v)| v - correction.get(k * run.nu + i).copied().unwrap_or(0.0))
+                    .collect(),
+            )
+        };
+        let missing = |name: &str| ReportError::BadInput {
+            source_name: self.source.clone(),
+            message: format!("the closed loop has no signal {name}"),
+        };
+        let ax = self.axis;
+        let set = format!("{ax}_pos_set_m");
+        let acc = format!("{ax}_acc_set_m_s2");
+        self.set_mm = nominal(set.clone())
+            .ok_or_else(|| missing(&set))?
+            .iter()
+            .map(|v| v * 1e3)
+            .collect();
+        self.acc_set_m_s2 = nominal(acc.clone()).ok_or_else(|| missing(&acc))?;
+        self.compensated_um = Axis::ALL
+            .into_iter()
+            .filter(|&b| b != ax)
+            .filter_map(|b| {
+                let set = nominal(format!("{b}_pos_set_m"))?;
+                let tcp = run.output_series(cl, &format!("{b}_tcp_m"))?;
+                Some((
+                    b,
+                    tcp.iter().zip(&set).map(|(e, s)| (e - s) * 1e6).collect(),
+                ))
+            })
+            .collect();
+        Ok(self)
     }
 
     /// Signed distance of the set position, mm.
@@ -223,14 +284,24 @@ pub fn move_svg(data: &MoveData, cond: &Conditions) -> Result<String, ReportErro
         "Positioning move of axis {}: set vs actual, TCP cross-talk",
         ax.letter()
     );
+    // The planned profile where known; else estimates from the samples (marked ≈).
+    let (v, a, j, approx) = match &data.plan {
+        Some(p) => (p.peak_velocity_m_s, p.peak_accel_m_s2, p.jerk_m_s3, ""),
+        None => (
+            data.peak_velocity_m_s(),
+            data.peak_accel_m_s2(),
+            data.peak_jerk_m_s3(),
+            "≈ ",
+        ),
+    };
     let lines = vec![
         format!(
-            "distance {} mm  ·  peak set velocity {} m/s ({} mm/min)  ·  peak set acceleration {} m/s²  ·  peak set jerk ≈ {} m/s³",
+            "distance {} mm  ·  peak set velocity {approx}{} m/s ({} mm/min)  ·  peak set acceleration {approx}{} m/s²  ·  peak set jerk {approx}{} m/s³",
             short(data.distance_mm(), 3),
-            short(data.peak_velocity_m_s(), 4),
-            short(data.peak_velocity_m_s() * 60_000.0, 0),
-            short(data.peak_accel_m_s2(), 3),
-            short(data.peak_jerk_m_s3(), 0)
+            short(v, 4),
+            short(v * 60_000.0, 0),
+            short(a, 3),
+            short(j, 0)
         ),
         cond.line("move start"),
     ];
@@ -327,11 +398,17 @@ pub fn move_svg(data: &MoveData, cond: &Conditions) -> Result<String, ReportErro
                 t_dec,
                 svg::decimals_for(hi - lo),
             )?;
-            let mut legend = Vec::new();
-            for (label, color, pts) in curves {
-                chart.draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))?;
-                legend.push(Entry::new(label.clone(), *color, Mark::Line));
+            // The first curve (the set point, or the main trace) is drawn last and thinner,
+            // over wider ones: where traces coincide (zero after the move) the one on top
+            // shows with an even rim instead of alternating dashes of both colours.
+            for (i, (_, color, pts)) in curves.iter().enumerate().rev() {
+                let width = if i == 0 { 1 } else { 3 };
+                chart.draw_series(LineSeries::new(pts.clone(), color.stroke_width(width)))?;
             }
+            let legend: Vec<Entry> = curves
+                .iter()
+                .map(|(label, color, _)| Entry::new(label.clone(), *color, Mark::Line))
+                .collect();
             svg::side_panel(&right, &legend, notes)?;
         }
         Ok(())

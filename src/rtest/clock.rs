@@ -3,7 +3,7 @@
 //! time base, and the clock offset between them estimated from the trajectories.
 //!
 //! Conventions: the clock offset o is the internal clock minus the external clock at the same
-//! instant (CONTRACT.md `time_offset_ms`), so an external sample stamped τ belongs to internal
+//! instant (docs/commands.md `time_offset_ms`), so an external sample stamped τ belongs to internal
 //! time τ + o. Interpolation is cubic (four-point Lagrange on the samples' own times): on a
 //! 2 mm circle at 8 Hz sampled at 1 kHz its error is below 1 nm, three orders under the
 //! R-Test's noise, where a straight line between samples would err by 0.6 µm.
