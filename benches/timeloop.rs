@@ -1,4 +1,4 @@
-//! The time loop against the plain C loop of `../shared/bench/fohloop.c` (the same
+//! The time loop against the plain C loop of `benches/fohloop.c` (the same
 //! first-order-hold recurrence, hand-written, vectorised): the demo's closed loop (n = 63,
 //! 15 outputs) on the zx circle at 5 m/s², 4 steady revolutions plus ramps, at 10 kHz.
 //!
@@ -53,7 +53,7 @@ fn fohloop_input(cl: &ClosedLoop, disc: &Discrete, x0: &[f64], inputs: &[f64]) -
 
 /// Compiles and runs fohloop on `input`; its median and the outputs it wrote.
 fn run_c(input: &[u8], dir: &Path) -> Option<(f64, Vec<f64>)> {
-    let source = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/bench/fohloop.c");
+    let source = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/fohloop.c");
     if !source.exists() {
         eprintln!("{} not found: no C comparison", source.display());
         return None;

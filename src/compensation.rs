@@ -33,7 +33,7 @@ pub(crate) const MIN_IMPROVEMENT: f64 = 0.2;
 /// Step of the central differences that give the correction's velocity and acceleration, s.
 pub const DIFF_STEP_S: f64 = 2.5e-4;
 
-/// The CSV header of a compensation table (CONTRACT.md, then eij's own column).
+/// The CSV header of a compensation table (docs/commands.md, then eij's own column).
 pub const HEADER: &str = "parameter,adaptation_axis,offset_um_s2_per_m,slope_um_s2_per_m_per_mm,worst_residual_um_s2_per_m";
 
 /// Errors of building or reading a compensation table.
@@ -284,7 +284,7 @@ impl CompensationTable {
         s
     }
 
-    /// Reads a table for `machine`: the CONTRACT.md columns in any order (the worst residual
+    /// Reads a table for `machine`: the docs/commands.md columns in any order (the worst residual
     /// optional, other columns refused as a likely unit mistake); every parameter at most once,
     /// its axes and adaptation axis on the machine, every number finite.
     pub fn read(path: &Path, machine: &Machine) -> Result<Self, CompensationError> {

@@ -37,7 +37,7 @@ use std::sync::Arc;
 
 pub use crate::axes::EijMap;
 
-/// The conditions of one circle test (CONTRACT.md: plane, direction, set radius, set
+/// The conditions of one circle test (docs/commands.md: plane, direction, set radius, set
 /// acceleration a = r·ω², circle centre).
 #[derive(Debug, Clone, PartialEq)]
 pub struct CircleTest {

@@ -58,7 +58,7 @@ pub fn compact_numbers(line: &str) -> String {
 }
 
 /// A unit as written for people: `um` → `µm`, `um_per_m` → `µm/m`, `um_s2_per_m` → `µm·s²/m`
-/// (the JSON's unit names, CONTRACT.md); others as they are.
+/// (the JSON's unit names, docs/commands.md); others as they are.
 pub fn unit_symbol(unit: &str) -> &str {
     match unit {
         "um" => "µm",

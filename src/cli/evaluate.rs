@@ -24,7 +24,7 @@ pub struct EvaluateArgs {
     /// a warning; the data must agree within 10 %).
     #[arg(long, allow_hyphen_values = true)]
     pub radius_mm: Option<f64>,
-    /// Print one JSON object (CONTRACT.md) instead of a table.
+    /// Print one JSON object (docs/commands.md) instead of a table.
     #[arg(long)]
     pub json: bool,
     /// Also write the EIJ table (CSV) of all tests to this file.

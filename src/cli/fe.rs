@@ -1,5 +1,5 @@
 //! `eij fe --machine FILE.toml --body NAME [--json]`: an elastic body's FE model and its
-//! reduction (CONTRACT "Flexible bodies"; docs/fe.md).
+//! reduction (docs/fe.md; docs/fe.md).
 
 use super::console::Progress;
 use eij::fe::FeSummary;
@@ -17,7 +17,7 @@ pub struct FeArgs {
     /// The elastic body (a `[[body]]` with `[body.fe]` or `[body.beam]`).
     #[arg(long, value_name = "NAME")]
     body: String,
-    /// Print one JSON object (CONTRACT keys) instead of text.
+    /// Print one JSON object (docs/fe.md keys) instead of text.
     #[arg(long)]
     json: bool,
 }

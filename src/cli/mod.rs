@@ -1,4 +1,4 @@
-//! Command-line interface of the `eij` binary (names fixed by CONTRACT.md).
+//! Command-line interface of the `eij` binary (names fixed by docs/commands.md).
 
 use clap::{Parser, Subcommand};
 

@@ -32,7 +32,7 @@ enum Test {
 struct Common {
     #[command(flatten)]
     machine: MachineArgs,
-    /// Output CSV file (CONTRACT.md columns).
+    /// Output CSV file (docs/commands.md columns).
     #[arg(long, value_name = "FILE.csv")]
     out: PathBuf,
     /// Output sample rate, Hz.

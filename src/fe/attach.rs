@@ -1,4 +1,4 @@
-//! Points attached to an elastic body, by CONTRACT's rules.
+//! Points attached to an elastic body, by the rules of docs/fe.md.
 //!
 //! Every attachment goes through *stations*: a station is a 6-DOF motion (translation u and
 //! rotation θ at its reference point r) that is a linear function W u_FE of the FE displacements:
@@ -200,7 +200,7 @@ impl Builder<'_> {
         })
     }
 
-    /// The station of a point by CONTRACT's rule.
+    /// The station of a point by the rule of docs/fe.md.
     fn at_point(&mut self, p: &Vector3<f64>, what: &str) -> Result<usize, String> {
         let (near, dist) = self.nearest(p);
         if near == usize::MAX {

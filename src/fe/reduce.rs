@@ -40,7 +40,7 @@ pub struct ReductionSettings {
     /// Resolve the body's free-free modes up to this frequency instead, Hz: every fixed-interface
     /// mode below [`CUTOFF_MARGIN`] × `cutoff_hz` is kept.
     pub cutoff_hz: Option<f64>,
-    /// RBE3 radius on solid (3-DOF) nodes, m (CONTRACT `attach_radius_m`).
+    /// RBE3 radius on solid (3-DOF) nodes, m (docs/fe.md `attach_radius_m`).
     pub attach_radius_m: Option<f64>,
     /// Reduce the interface to the six rigid-body motions plus this many characteristic
     /// constraint modes (the lowest modes of the interface's Guyan model), where the stations
@@ -105,7 +105,7 @@ pub struct StationSummary {
     pub weights: Vec<f64>,
 }
 
-/// What `eij fe` prints (CONTRACT keys).
+/// What `eij fe` prints (docs/fe.md keys).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FeSummary {
     /// The body's name.

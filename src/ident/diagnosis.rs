@@ -284,7 +284,7 @@ pub fn fitted_clocks(result: &IdentResult) -> Vec<FittedClockReport> {
         .collect()
 }
 
-/// A clock whose offset the evaluation estimated (CONTRACT.md `time_offset_ms`: internal
+/// A clock whose offset the evaluation estimated (docs/commands.md `time_offset_ms`: internal
 /// clock minus external clock; a probe logger lagging the scales by δ gives −δ).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ClockOffsetReport {

@@ -1,5 +1,5 @@
 //! Measured EIJ for identification, from R-Test CSV files (through the evaluation), folders of
-//! them, or EIJ tables (CONTRACT.md).
+//! them, or EIJ tables (docs/commands.md).
 
 pub use super::settings::MeasuredOptions;
 use super::{IdentError, TestCase};

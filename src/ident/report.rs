@@ -1,5 +1,5 @@
 //! Outputs of an identification, one serde type per file, written and read by the same type:
-//! the report JSON ([`IdentReport`], CONTRACT.md keys) and the identified machine file with its
+//! the report JSON ([`IdentReport`], docs/commands.md keys) and the identified machine file with its
 //! `[provenance]` table ([`machine_toml`], [`crate::machine::raw::RawProvenance`]).
 
 use super::diagnosis::{
@@ -111,7 +111,7 @@ fn nan_matrix<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<Vec<f64>>, D::Error
         .collect())
 }
 
-/// The report JSON of `eij identify` (CONTRACT.md): parameters with standard errors and
+/// The report JSON of `eij identify` (docs/commands.md): parameters with standard errors and
 /// correlations, costs, warnings, settings, and per test the measured and simulated EIJ before
 /// and after. Keys that older reports may lack are optional for reading; `eij identify` writes
 /// every one.

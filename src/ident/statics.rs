@@ -279,9 +279,11 @@ impl Statics {
     }
 
     /// Adds a clock-offset term per clock whose tests hold both directions (`clock_of[test]`
-    /// names each test's clock; see the module docs): external readings late by δ (ms) shift
-    /// the cross-talk of plane (a, b) by Ê_ab += 10³·δ/ω, Ê_ba −= 10³·δ/ω (ω signed, rad/s;
-    /// [`crate::rtest::clock_fit`]), so the column's entries are ∓10³/(ωσ) in those rows. The
+    /// names each test's clock; see the module docs): external readings late by δ (ms) read
+    /// x(t − δ) ≈ x − δ·v and shift the cross-talk of plane (a, b) by Ê_ab −= 10³·δ/ω,
+    /// Ê_ba += 10³·δ/ω (ω signed, rad/s; [`crate::rtest::clock_fit`];
+    /// `tests/rtest_clock_sign.rs`), so the column's entries are ∓10³/(ωσ) in those rows and
+    /// the fitted δ is positive for late external readings (`external_late_ms`). The
     /// path's speed is taken as the set speed (ρ = r): a servo radius error of 1 % scales δ by
     /// 1 %.
     /// A velocity-proportional structural deviation (damping) has the same shape, but the model

@@ -1,6 +1,6 @@
 //! Elastic bodies from `[body.fe]` and `[body.beam]`: the FE model ([`crate::fe`]) reduced for
 //! the points the machine attaches to the body, and coupled through those attachments
-//! (CONTRACT "Flexible bodies"):
+//! (docs/fe.md):
 //!
 //! * a point fixed on the body (a carriage or the nut on the moving body, joints, the TCP)
 //!   attaches by the contract's rule (nearest 6-DOF node through the lever arm, or an RBE3 patch
@@ -31,7 +31,7 @@ use std::sync::{Arc, Mutex, OnceLock};
 /// Default number of fixed-interface modes where neither `modes` nor `cutoff_hz` is given.
 pub(crate) const DEFAULT_MODES: usize = 20;
 
-/// How far given mass properties may differ from the FE model's (CONTRACT): mass and inertia
+/// How far given mass properties may differ from the FE model's (docs/fe.md): mass and inertia
 /// relative, COG relative to the body's extent.
 const MASS_AGREEMENT: f64 = 0.01;
 
@@ -255,7 +255,7 @@ impl Machine {
         }
     }
 
-    /// `eij fe`'s summary of body `b` (CONTRACT "Flexible bodies"): its FE model, its reduction
+    /// `eij fe`'s summary of body `b` (docs/fe.md): its FE model, its reduction
     /// for this machine's attachments (at the reference position) and, for comparison, the full
     /// model's elastic free-free frequencies (the model read or built again, a sparse
     /// eigensolution of the whole model). Frequencies hold at the body's stiffness factor.
@@ -480,7 +480,7 @@ fn agrees(difference: f64, scale: f64) -> bool {
     difference <= MASS_AGREEMENT * scale
 }
 
-/// Mass, COG and inertia given beside an FE model must agree with it (CONTRACT): mass within
+/// Mass, COG and inertia given beside an FE model must agree with it (docs/fe.md): mass within
 /// 1 %, COG within 1 % of the body's extent, inertia within 1 % of its largest principal value.
 fn check_given_mass(rb: &RawBody, r: &Reduction) -> Result<(), FieldError> {
     let fe = &r.reduced.mass;

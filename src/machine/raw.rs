@@ -104,7 +104,7 @@ fn default_damping_ratio() -> f64 {
     0.02
 }
 
-/// `[body.fe]`: an FE model as exported (CONTRACT "Flexible bodies"). Files are relative to the
+/// `[body.fe]`: an FE model as exported (docs/fe.md). Files are relative to the
 /// machine file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -376,7 +376,7 @@ impl StiffnessTable {
         }
     }
 
-    /// The table as CSV (CONTRACT.md columns; an identified table adds `std_err_n_per_um` and
+    /// The table as CSV (docs/commands.md columns; an identified table adds `std_err_n_per_um` and
     /// `parameter`, empty where a factor was not identified). Numbers are written in full
     /// (shortest round-trip form), so two tables of the same stiffness set are equal as text.
     pub fn to_csv(&self) -> Vec<u8> {

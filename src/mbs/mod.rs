@@ -308,7 +308,7 @@ impl Model {
                 .copy_from(&t.rows(0, 3));
         }
         // The nest is set up under the tool at this circle centre: the point of the workpiece
-        // body that coincides with the TCP at this pose (CONTRACT: x_ext_mm).
+        // body that coincides with the TCP at this pose (docs/commands.md: x_ext_mm).
         let mut nest_rotation = DMatrix::zeros(3, n);
         if let Some((i, t)) = port(machine.workpiece().body, Site::Workpiece, &tcp_point)? {
             let mut v = tcp.view_mut((0, i), (3, t.ncols()));

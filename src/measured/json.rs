@@ -1,5 +1,5 @@
-//! The JSON of one evaluated circle test (`eij evaluate --json`, CONTRACT.md), as one serde type
-//! that writes and reads it: [`CircleJson`]. The keys are CONTRACT.md's (`file`, `plane`,
+//! The JSON of one evaluated circle test (`eij evaluate --json`, docs/commands.md), as one serde type
+//! that writes and reads it: [`CircleJson`]. The keys are docs/commands.md's (`file`, `plane`,
 //! `direction`, `radius_mm`, `accel_m_s2`, `freq_hz`, `eij_um_s2_per_m`, `std_err_um_s2_per_m`,
 //! `rms_residual_um`) and eij's own additions documented in docs/measurement-files.md.
 
@@ -175,7 +175,7 @@ pub struct TimeOffsetJson {
 }
 
 impl CircleResult {
-    /// The CONTRACT.md JSON object of one test (`file`, `plane`, `direction`, `radius_mm`,
+    /// The docs/commands.md JSON object of one test (`file`, `plane`, `direction`, `radius_mm`,
     /// `accel_m_s2`, `freq_hz`, `eij_um_s2_per_m`, `std_err_um_s2_per_m`, `rms_residual_um`)
     /// plus `measured_radius_mm`, `offsets_um`, `revolutions`, `samples_used`, `plane_fit`,
     /// `ellipse_fit` (null when it failed) and `warnings`.

@@ -10,7 +10,7 @@ use crate::rtest::moves::{evaluate_record, MoveEij, MoveError, MoveRecord};
 /// Most samples read from one move file (100 s at 10 kHz).
 pub const MAX_SAMPLES: usize = 1_000_000;
 
-/// Reads a move of axis `axis` (CONTRACT.md columns plus the set point of the moved axis).
+/// Reads a move of axis `axis` (docs/commands.md columns plus the set point of the moved axis).
 pub fn read(path: &Path, axis: Axis) -> Result<MoveRecord, MoveError> {
     let file = path.display().to_string();
     let err = |at: String, message: String| MoveError {
@@ -143,7 +143,7 @@ pub fn read(path: &Path, axis: Axis) -> Result<MoveRecord, MoveError> {
     Ok(rec)
 }
 
-/// Evaluates a move of axis `axis` recorded in `path` (CONTRACT.md columns plus the set point of
+/// Evaluates a move of axis `axis` recorded in `path` (docs/commands.md columns plus the set point of
 /// the moved axis).
 pub fn evaluate_move(path: &Path, axis: Axis) -> Result<MoveEij, MoveError> {
     let rec = read(path, axis)?;

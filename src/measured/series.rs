@@ -1,4 +1,4 @@
-//! Circle-test series read from CSV files (CONTRACT.md columns; dialects and column maps of
+//! Circle-test series read from CSV files (docs/commands.md columns; dialects and column maps of
 //! [`super::layout`]), and the column and file helpers the other readers of measured files share.
 
 use std::path::Path;
@@ -10,7 +10,7 @@ use crate::rtest::series::CONTRACT_COLUMNS;
 use crate::rtest::{CircleSeries, Location};
 
 impl CircleSeries {
-    /// Reads a circle-test CSV (CONTRACT.md): required columns `t_s`, `{x,y,z}_int_mm`,
+    /// Reads a circle-test CSV (docs/commands.md): required columns `t_s`, `{x,y,z}_int_mm`,
     /// `{x,y,z}_ext_mm` in any order; other columns ignored. The dialect (separator, decimal
     /// comma, comment lines, a metadata block before the header) is recognised, see
     /// [`super::layout`].

@@ -1,4 +1,4 @@
-//! EIJ table (CONTRACT.md): `plane,direction,accel_m_s2,parameter,value_um_s2_per_m` and
+//! EIJ table (docs/commands.md): `plane,direction,accel_m_s2,parameter,value_um_s2_per_m` and
 //! optionally `std_err_um_s2_per_m`, one row per parameter value. For values taken from a
 //! report, typed by hand, or written by `eij evaluate --csv-out`.
 

@@ -139,7 +139,7 @@ pub(crate) fn figures(
     let conditions = format!(
         "set radius r = {} mm · feed {} mm/min ({} Hz) · {} · {} steady revolutions",
         short(r.radius_mm, 4),
-        short((feed_mm_min(r) / 10.0).round() * 10.0, 0),
+        short(feed_mm_min(r), 0),
         short(r.freq_hz, 3),
         dirs.join(" and "),
         revs.join(" / ")

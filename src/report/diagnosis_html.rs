@@ -156,7 +156,7 @@ pub(crate) fn breakdown_html(
          source, ranked by share of G</p>\n",
         badge(v),
         escape(label),
-        d.feed_mm_min
+        super::labels::shown_feed(d.feed_mm_min)
     );
     if let Some(v) = verdict {
         let failed = failed_checks(v);

@@ -56,12 +56,7 @@ pub(crate) fn conditions_line(t: &[EvaluatedTest]) -> String {
         dirs.into_iter().collect::<Vec<_>>().join(", "),
         distinct(t.iter().map(|t| t.result.radius_mm), 4),
         distinct(t.iter().map(|t| t.result.accel_m_s2), 1),
-        // To 10 mm/min: the programmed feeds, not the last digit of ω.
-        distinct(
-            t.iter()
-                .map(|t| (feed_mm_min(&t.result) / 10.0).round() * 10.0),
-            0
-        ),
+        distinct(t.iter().map(|t| feed_mm_min(&t.result)), 0),
         centres.into_iter().collect::<Vec<_>>().join(", ")
     )
 }
@@ -114,7 +109,13 @@ pub(crate) fn position_label(p: &[f64]) -> String {
     p.iter().map(|v| short(*v, 1)).collect::<Vec<_>>().join(",")
 }
 
-/// The path speed of a circle test, mm/min: 2π·r·f·60.
+/// The path speed of a circle test, mm/min: 2π·r·f·60, as the page shows it ([`shown_feed`]).
 pub fn feed_mm_min(r: &CircleResult) -> f64 {
-    std::f64::consts::TAU * r.radius_mm * r.freq_hz * 60.0
+    shown_feed(std::f64::consts::TAU * r.radius_mm * r.freq_hz * 60.0)
+}
+
+/// A feed as the page shows it, to 10 mm/min: the programmed feed the circle ran at, not the
+/// last digit of ω — one rule for the header, the tables and the certificate (3795.4 → 3790).
+pub fn shown_feed(mm_min: f64) -> f64 {
+    (mm_min / 10.0).round() * 10.0
 }

@@ -3,7 +3,7 @@
 //! time base, and the clock offset between them estimated from the trajectories.
 //!
 //! Conventions: the clock offset o is the internal clock minus the external clock at the same
-//! instant (CONTRACT.md `time_offset_ms`), so an external sample stamped τ belongs to internal
+//! instant (docs/commands.md `time_offset_ms`), so an external sample stamped τ belongs to internal
 //! time τ + o. Interpolation is cubic (four-point Lagrange on the samples' own times): on a
 //! 2 mm circle at 8 Hz sampled at 1 kHz its error is below 1 nm, three orders under the
 //! R-Test's noise, where a straight line between samples would err by 0.6 µm.
@@ -11,7 +11,8 @@
 //! The trajectory alignment ([`align`]) minimises the mean square distance between the
 //! external and the internal path over the whole overlap, ramps and rests included, so that it
 //! has one minimum and not one per revolution. It cannot tell a clock offset from the
-//! structural deviation itself: on a steady circle a residual offset δ adds δ·v, and v_a has
+//! structural deviation itself: on a steady circle a residual offset δ (internal minus external
+//! clock; negative for late external readings) adds δ·v, and v_a has
 //! the shape of the acceleration of the other axis, so the alignment absorbs the antisymmetric
 //! in-plane cross-talk (E_ab − E_ba)·ω/2 (tens of µs). [`super::clock_fit`] separates the two
 //! across tests.

@@ -1,12 +1,15 @@
 //! The clock-offset term of a pooled evaluation: one residual time offset δ between the
 //! internal and the external time base, fitted jointly over several circle tests.
 //!
-//! Physics: with the external samples δ late against the internal ones, the deviation gains
-//! δ·v. On a steady circle v_a = (ρ/r)·ä_b/ω and v_b = −(ρ/r)·ä_a/ω (ρ the path's radius, r the
-//! set radius of the set accelerations), so in one test δ is indistinguishable from
-//! antisymmetric in-plane cross-talk: the joint fit returns E_ab + (ρ/r)·δ/ω and
-//! E_ba − (ρ/r)·δ/ω (δ in s, E in µm·s²/m: a factor 10⁶). The shift flips sign between cw and ccw and scales
-//! with 1/ω ∝ 1/√a, while EIJ do not change; static geometry G (µm per mm of set position)
+//! Physics: δ is the offset to add to the internal-minus-external clock offset, so external
+//! samples late by τ against the internal ones (the sample stamped t is the position at t − τ)
+//! have δ = −τ, read x(t − τ) ≈ x − τ·v, and the deviation gains δ·v
+//! (`tests/rtest_clock_sign.rs` measures the sign on series lagged by whole samples). On a
+//! steady circle v_a = (ρ/r)·ä_b/ω and v_b = −(ρ/r)·ä_a/ω (ρ the path's radius, r the set
+//! radius of the set accelerations), so in one test δ is indistinguishable from antisymmetric
+//! in-plane cross-talk: the joint fit returns E_ab + (ρ/r)·δ/ω and E_ba − (ρ/r)·δ/ω (δ in s, E
+//! in µm·s²/m: a factor 10⁶). The shift flips sign between cw and ccw and scales with
+//! 1/ω ∝ 1/√a, while EIJ do not change; static geometry G (µm per mm of set position)
 //! enters as −10³·G/ω², even in ω. Across tests of one plane at one position the per-test
 //! cross-talk is therefore
 //!

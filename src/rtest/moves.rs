@@ -110,7 +110,7 @@ pub(crate) fn evaluate_record(
 }
 
 impl MoveEij {
-    /// The CONTRACT.md JSON: `axis`, `eij_um_s2_per_m`, `std_err_um_s2_per_m`, plus `file`,
+    /// The docs/commands.md JSON: `axis`, `eij_um_s2_per_m`, `std_err_um_s2_per_m`, plus `file`,
     /// `rms_residual_um` (x, y, z), `peak_accel_m_s2` and `samples`.
     pub fn to_json(&self) -> serde_json::Value {
         let names = |m: &EijMap| -> serde_json::Map<String, serde_json::Value> {

@@ -1,4 +1,4 @@
-//! Circle-test time series (CONTRACT.md columns), validated on construction. Files are read
+//! Circle-test time series (docs/commands.md columns), validated on construction. Files are read
 //! into it by [`crate::measured`] (`CircleSeries::read_csv` and its variants), the simulator
 //! hands its runs over through [`CircleSeries::new`].
 

@@ -172,7 +172,7 @@ impl fmt::Display for Warning {
                 plane,
             } => write!(
                 f,
-                "rtest.toml says {stated}, the data turn {measured} (CONTRACT.md: ccw is ω > 0 in \
+                "rtest.toml says {stated}, the data turn {measured} (docs/commands.md: ccw is ω > 0 in \
                  a = r cos ωt, b = r sin ωt of plane {plane})"
             ),
             Warning::FeedDisagrees {

@@ -1,5 +1,5 @@
 //! Time-domain simulation of the closed loop: exact discretisation with a first-order hold on
-//! the set points, and the R-Test-like output series of CONTRACT.md.
+//! the set points, and the R-Test-like output series of docs/commands.md.
 //!
 //! Over one output step h, with the set points linear between samples
 //! (u(t) = u_k + (t − t_k)/h·(u_{k+1} − u_k)), the exact solution of ẋ = A x + B u is

@@ -1,4 +1,4 @@
-//! The simulated R-Test series in the CSV layout of CONTRACT.md.
+//! The simulated R-Test series in the CSV layout of docs/commands.md.
 //!
 //! Columns: `t_s`; `x_int_mm`, `y_int_mm`, `z_int_mm` (linear-scale readings relative to the
 //! circle centre or move start; 0 for an axis the machine lacks); `x_ext_mm`, `y_ext_mm`,

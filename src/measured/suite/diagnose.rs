@@ -44,7 +44,7 @@ impl SuiteDiagnosis {
             .collect()
     }
 
-    /// Test `i`'s `"diagnosis"` object (CONTRACT.md), and its `"verdict"` where judged.
+    /// Test `i`'s `"diagnosis"` object (docs/commands.md), and its `"verdict"` where judged.
     pub fn test_json(&self, i: usize) -> (Value, Option<Value>) {
         let verdict = self.verdicts[i].as_ref().map(|v| json!(v));
         (self.tests[i].to_json(), verdict)

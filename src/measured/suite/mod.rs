@@ -392,7 +392,7 @@ impl EvaluatedTest {
 }
 
 impl Suite {
-    /// The evaluate JSON document (CONTRACT.md): `tests`, and `bidirectional` (cw/ccw pairs
+    /// The evaluate JSON document (docs/commands.md): `tests`, and `bidirectional` (cw/ccw pairs
     /// with `files`, `plane`, `accel_m_s2`, `bidirectional_circular_deviation_um` internal and
     /// external), `clocks` and `warnings`.
     pub fn to_json_map(&self) -> serde_json::Map<String, serde_json::Value> {

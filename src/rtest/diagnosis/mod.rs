@@ -138,7 +138,7 @@ pub struct CrossingValue {
 /// One named term of a source's decomposition.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Term {
-    /// CONTRACT.md name (`scale_mismatch`, `backlash_x`, …).
+    /// docs/commands.md name (`scale_mismatch`, `backlash_x`, …).
     pub name: String,
     /// Value in `unit`.
     pub value: f64,
@@ -271,7 +271,7 @@ impl CircleDiagnosis {
         &self.sources[source as usize]
     }
 
-    /// CONTRACT.md `"diagnosis"` object: `{"internal": {...}, "structure": {...}, "tcp": {...}}`.
+    /// docs/commands.md `"diagnosis"` object: `{"internal": {...}, "structure": {...}, "tcp": {...}}`.
     pub fn to_json(&self) -> serde_json::Value {
         let map = self
             .sources

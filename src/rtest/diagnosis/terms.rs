@@ -50,7 +50,7 @@ pub(crate) enum Family {
 /// One named term of the design.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Spec {
-    /// CONTRACT.md name, e.g. `backlash_x`.
+    /// docs/commands.md name, e.g. `backlash_x`.
     pub name: String,
     /// Unit of the value.
     pub unit: &'static str,
