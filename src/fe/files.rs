@@ -1,5 +1,6 @@
 //! An FE model from the files an FE program exported: Matrix Market M and K, the DOF map
-//! (`node,dof`, one line per matrix row in row order) and the nodes (`node,x_m,y_m,z_m`).
+//! (`node,dof`, one line per matrix row in row order, or the mapping file ANSYS's `HBMAT` writes)
+//! and the nodes (`node,x_m,y_m,z_m`).
 
 use super::{mtx, DofKind, FeError, FeModel, Node};
 use crate::io::read::read_input;
@@ -110,19 +111,25 @@ fn reader(path: &Path, header: &[&str]) -> Result<(String, Table), FeError> {
     let file = path.display().to_string();
     let bytes =
         read_input(path, MAX_TABLE_BYTES).map_err(|e| FeError::file(&file, e.to_string()))?;
+    let rdr = table(&file, bytes, header)?;
+    Ok((file, rdr))
+}
+
+/// A CSV table whose header must be `header` (any case).
+fn table(file: &str, bytes: Vec<u8>, header: &[&str]) -> Result<Table, FeError> {
     let mut rdr = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .comment(Some(b'#'))
         .from_reader(std::io::Cursor::new(bytes));
     let got: Vec<String> = rdr
         .headers()
-        .map_err(|e| FeError::line(&file, 1, format!("not a CSV header: {e}")))?
+        .map_err(|e| FeError::line(file, 1, format!("not a CSV header: {e}")))?
         .iter()
         .map(|h| h.to_ascii_lowercase())
         .collect();
     if got.len() != header.len() || got.iter().zip(header).any(|(g, h)| g != h) {
         return Err(FeError::line(
-            &file,
+            file,
             1,
             format!(
                 "the header must be `{}`, found `{}`",
@@ -131,7 +138,50 @@ fn reader(path: &Path, header: &[&str]) -> Result<(String, Table), FeError> {
             ),
         ));
     }
-    Ok((file, rdr))
+    Ok(rdr)
+}
+
+/// The mapping file of ANSYS's `HBMAT` (`Mapping = YES`): a header line `Matrix Eqn  Node  DOF`,
+/// then per matrix equation, in equation order, `equation node label` separated by blanks
+/// (labels `UX UY UZ ROTX ROTY ROTZ`). Equations must count 1, 2, 3, … (the matrices' row order).
+fn read_ansys_mapping(
+    file: &str,
+    bytes: &[u8],
+    add: &mut impl FnMut(usize, &str, &str) -> Result<(), String>,
+) -> Result<(), FeError> {
+    let text =
+        std::str::from_utf8(bytes).map_err(|_| FeError::file(file, "not text (invalid UTF-8)"))?;
+    let mut header = false;
+    let mut equation = 0usize;
+    for (i, line) in text.lines().enumerate() {
+        let line_no = i + 1;
+        let l = line.trim();
+        if l.is_empty() {
+            continue;
+        }
+        if !header {
+            header = true;
+            continue;
+        }
+        let f: Vec<&str> = l.split_ascii_whitespace().collect();
+        let [eqn, node, dof] = f.as_slice() else {
+            return Err(FeError::line(
+                file,
+                line_no,
+                format!("expected `equation node dof` (an ANSYS mapping file), found `{l}`"),
+            ));
+        };
+        equation += 1;
+        if eqn.parse::<usize>().ok() != Some(equation) {
+            return Err(FeError::line(
+                file,
+                line_no,
+                format!("equation `{eqn}` where {equation} is next: the mapping lists the matrix equations in order, one per line"),
+            ));
+        }
+        add(line_no, node, dof).map_err(|m| FeError::line(file, line_no, m))?;
+    }
+    Ok(())
 }
 
 fn records(
@@ -184,18 +234,23 @@ fn read_nodes(path: &Path) -> Result<Vec<Node>, FeError> {
     Ok(nodes)
 }
 
+/// The header of the mapping file ANSYS's `HBMAT` writes (`Matrix Eqn  Node  DOF`).
+const ANSYS_MAPPING: &str = "matrix eqn";
+
 fn read_dofs(path: &Path, nodes: &[Node], n: usize) -> Result<Vec<(u64, DofKind)>, FeError> {
-    let (file, mut rdr) = reader(path, &["node", "dof"])?;
+    let file = path.display().to_string();
+    let bytes =
+        read_input(path, MAX_TABLE_BYTES).map_err(|e| FeError::file(&file, e.to_string()))?;
     let known: std::collections::HashSet<u64> = nodes.iter().map(|p| p.id).collect();
     let mut seen = std::collections::HashMap::new();
     let mut map = Vec::with_capacity(n);
-    records(&file, &mut rdr, |line, rec| {
-        let id = node_id(&rec[0])?;
+    let mut add = |line: usize, node: &str, dof: &str| {
+        let id = node_id(node)?;
         if !known.contains(&id) {
             return Err(format!("node {id} is not in the node file"));
         }
-        let kind = DofKind::parse(&rec[1])
-            .ok_or_else(|| format!("dof `{}` is none of ux uy uz rx ry rz", &rec[1]))?;
+        let kind = DofKind::parse(dof)
+            .ok_or_else(|| format!("dof `{dof}` is none of ux uy uz rx ry rz"))?;
         if let Some(first) = seen.insert((id, kind), line) {
             return Err(format!(
                 "node {id} {} given twice (first on line {first})",
@@ -204,7 +259,17 @@ fn read_dofs(path: &Path, nodes: &[Node], n: usize) -> Result<Vec<(u64, DofKind)
         }
         map.push((id, kind));
         Ok(())
-    })?;
+    };
+    let first = bytes
+        .split(|&b| b == b'\n')
+        .map(|l| String::from_utf8_lossy(l).trim().to_ascii_lowercase())
+        .find(|l| !l.is_empty());
+    if first.is_some_and(|l| l.starts_with(ANSYS_MAPPING)) {
+        read_ansys_mapping(&file, &bytes, &mut add)?;
+    } else {
+        let mut rdr = table(&file, bytes, &["node", "dof"])?;
+        records(&file, &mut rdr, |line, rec| add(line, &rec[0], &rec[1]))?;
+    }
     if map.len() != n {
         return Err(FeError::file(
             &file,

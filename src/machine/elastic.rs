@@ -381,30 +381,11 @@ impl Machine {
             let err = |k: &str, m: String| {
                 MachineError::new(&self.source, format!("body[{}].{key}{k}", rb.name), m)
             };
-            let (modes, cutoff_hz, damping, factor, radius) = match &source {
-                Source::Files(f, _) => (
-                    f.modes,
-                    f.cutoff_hz,
-                    f.damping_ratio,
-                    f.stiffness_factor,
-                    f.attach_radius_m,
-                ),
-                Source::Beam(b) => (
-                    b.modes,
-                    b.cutoff_hz,
-                    b.damping_ratio,
-                    b.stiffness_factor,
-                    None,
-                ),
+            let (damping, factor) = match &source {
+                Source::Files(f, _) => (f.damping_ratio, f.stiffness_factor),
+                Source::Beam(b) => (b.damping_ratio, b.stiffness_factor),
             };
-            check_settings(modes, cutoff_hz, factor, radius).map_err(|(k, m)| err(k, m))?;
-            let settings = ReductionSettings {
-                modes: modes.unwrap_or(DEFAULT_MODES),
-                cutoff_hz,
-                attach_radius_m: radius,
-                interface_modes: None,
-                full_reference: false,
-            };
+            let settings = settings(&source).map_err(|(k, m)| err(k, m))?;
             let (attachments, reach) = self.attachments(b);
             let reduction =
                 reduce(&source, &settings, &attachments).map_err(|e| err("", e.to_string()))?;
@@ -443,6 +424,48 @@ impl Machine {
 }
 
 type FieldError = (&'static str, String);
+
+/// Most interface coordinates `interface_modes` may ask for beyond the six rigid-body motions.
+const MAX_INTERFACE_MODES: usize = 1000;
+
+/// The reduction settings a `[body.fe]` or `[body.beam]` gives, checked: an error names the
+/// key (relative to the block).
+fn settings(source: &Source) -> Result<ReductionSettings, FieldError> {
+    let (modes, cutoff_hz, factor, radius, interface_modes) = match source {
+        Source::Files(f, _) => (
+            f.modes,
+            f.cutoff_hz,
+            f.stiffness_factor,
+            f.attach_radius_m,
+            f.interface_modes,
+        ),
+        Source::Beam(b) => (
+            b.modes,
+            b.cutoff_hz,
+            b.stiffness_factor,
+            None,
+            b.interface_modes,
+        ),
+    };
+    check_settings(modes, cutoff_hz, factor, radius)?;
+    if let Some(k) = interface_modes {
+        if !(1..=MAX_INTERFACE_MODES).contains(&k) {
+            return Err((
+                ".interface_modes",
+                format!(
+                    "{k} must be in 1 … {MAX_INTERFACE_MODES} (interface coordinates kept beside the six rigid-body motions)"
+                ),
+            ));
+        }
+    }
+    Ok(ReductionSettings {
+        modes: modes.unwrap_or(DEFAULT_MODES),
+        cutoff_hz,
+        attach_radius_m: radius,
+        interface_modes,
+        full_reference: false,
+    })
+}
 
 fn check_settings(
     modes: Option<usize>,

@@ -132,6 +132,11 @@ pub struct RawFe {
     /// RBE3 radius on solid (3-DOF) nodes, m.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub attach_radius_m: Option<f64>,
+    /// Interface coordinates beyond the six rigid-body motions (characteristic constraint
+    /// modes), where the attachments' stations carry more DOFs than that: keeps the elastic
+    /// coordinate count small on a body with long rails (docs/machine-file.md).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub interface_modes: Option<usize>,
 }
 
 /// `[body.beam]`: a straight 3D Timoshenko beam eij builds (6 DOF per node).
@@ -174,6 +179,9 @@ pub struct RawBeam {
     /// Factor on the whole elastic stiffness (E and G alike); identification writes it.
     #[serde(default = "one", skip_serializing_if = "is_one")]
     pub stiffness_factor: f64,
+    /// Interface coordinates beyond the six rigid-body motions, as in [`RawFe`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub interface_modes: Option<usize>,
 }
 
 /// A linear axis: the moving body runs on guideways of the carrier body, driven by a ball screw.
