@@ -65,6 +65,10 @@ fn main() -> std::process::ExitCode {
             errln!("eij: {e}");
             std::process::ExitCode::from(cli::evaluate_diagnosis::EXIT_CODE)
         }
+        (Err(e), _) if e.is::<cli::compare::NotReproduced>() => {
+            errln!("eij: {e}");
+            std::process::ExitCode::from(cli::compare::EXIT_CODE)
+        }
         (Err(e), _) => {
             let line = eij::text::compact_numbers(&format!("{e:#}").replace('\n', " "));
             errln!("eij: error: {line}");

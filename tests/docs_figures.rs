@@ -4,7 +4,7 @@
 //! The commands of one file run in order in one scratch folder that holds the repository's
 //! `machines/`, `measurements/` and `tests/`, so a later command reads what an earlier wrote.
 //! `2>&1` after a command compares standard output followed by standard error. Masked alike
-//! on both sides: the run time of `eij identify` (`3 iterations, 0.1 s`).
+//! on both sides: the run time of `eij identify` (`3 iterations, 0.1 s`) and of `eij compare`.
 
 mod common;
 
@@ -59,8 +59,19 @@ fn examples(file: &str) -> Vec<Example> {
     out
 }
 
-/// `Identified demo-vmc from 36 tests (216 values), 3 iterations, 0.1 s` → `…, 3 iterations, T s`.
+/// `Identified demo-vmc from 36 tests (216 values), 3 iterations, 0.1 s` → `…, 3 iterations, T s`;
+/// `Compared 2 candidate models on … , 13.7 s` (`eij compare`) → `…, T s`.
 fn masked(line: &str) -> String {
+    if line.starts_with("Compared ") {
+        if let Some((head, time)) = line.rsplit_once(", ") {
+            if time
+                .strip_suffix(" s")
+                .is_some_and(|t| t.parse::<f64>().is_ok())
+            {
+                return format!("{head}, T s");
+            }
+        }
+    }
     match line.find(" iterations, ") {
         Some(k) => {
             let rest = &line[k + " iterations, ".len()..];

@@ -138,7 +138,7 @@ impl From<SolverArg> for SolverKind {
 
 /// `--static-terms`: the library's [`StaticTerms`] as the command line spells it.
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]
-enum StaticTermsArg {
+pub(super) enum StaticTermsArg {
     /// Shared terms where separable; reversal terms where the data need them (default).
     Auto,
     /// Shared terms where separable, never reversal terms.
@@ -167,11 +167,11 @@ pub struct VerifyArgs {
     files: Vec<PathBuf>,
 }
 
-struct Prepared {
-    problem: Problem,
-    provenance: Provenance,
+pub(super) struct Prepared {
+    pub(super) problem: Problem,
+    pub(super) provenance: Provenance,
     /// What reading the measured tests found (conditions, clocks), for the report's warnings.
-    warnings: Vec<eij::rtest::Named>,
+    pub(super) warnings: Vec<eij::rtest::Named>,
     /// How measured data were read (validation data are read alike).
     measured_options: MeasuredOptions,
     /// The clock offsets the evaluation estimated.
@@ -180,7 +180,7 @@ struct Prepared {
 
 /// The identification problem of a machine (read from `machine_path`) and measured inputs
 /// (expanded once by the caller, who also checks the outputs against their files).
-fn prepare(
+pub(super) fn prepare(
     machine: Machine,
     machine_path: &Path,
     measured_inputs: &MeasuredInputs,

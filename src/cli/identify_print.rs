@@ -205,80 +205,26 @@ fn print_eij_table(p: &Problem, result: &IdentResult) {
     }
 }
 
-/// One line per plane and circle centre: how well the identified model reproduces its tests.
+/// One line per plane and circle centre: how well the identified model reproduces its tests,
+/// with the static terms removed as in the χ² test ([`eij::ident::groups`]), so that the
+/// groups add up to it.
 fn print_groups(p: &Problem, result: &IdentResult) {
-    // z values with the label of their test and EIJ.
-    type Zs = Vec<(f64, String)>;
-    // (plane + centre, tests, z values).
-    let mut groups: Vec<(String, usize, Zs)> = Vec::new();
-    for (i, t) in p.tests().iter().enumerate() {
-        let label = t.label();
-        let key = match label.split_once(" @ ") {
-            Some((_, at)) => format!("{} @ {at}", t.circle.plane),
-            None => t.circle.plane.to_string(),
-        };
-        let z: Vec<(f64, String)> = t
-            .measured
-            .iter()
-            .map(
-                |(
-                    e,
-                    &Estimate {
-                        value: m,
-                        std_err: s,
-                    },
-                )| {
-                    let sim = result.simulated_final[i]
-                        .get(e)
-                        .copied()
-                        .unwrap_or(f64::NAN);
-                    (
-                        (sim - m) / s,
-                        format!(
-                            "{} {} {} {e}",
-                            t.circle.plane,
-                            t.circle.direction,
-                            short_accel(t)
-                        ),
-                    )
-                },
-            )
-            .collect();
-        match groups.iter_mut().find(|g| g.0 == key) {
-            Some(g) => {
-                g.1 += 1;
-                g.2.extend(z);
-            }
-            None => groups.push((key, 1, z)),
-        }
-    }
     outln!(
-        "\n  per plane and circle centre: z = (identified model − measured) / σ over the EIJ of its tests\n  \
+        "\n  per plane and circle centre: z = (identified model − measured − static terms) / σ over the EIJ of its tests\n  \
          {:<28} tests  values  rms z  max |z| (test, EIJ)",
         "plane @ circle centre"
     );
-    for (key, n, z) in &groups {
-        let rms = (z.iter().map(|(v, _)| v * v).sum::<f64>() / z.len().max(1) as f64).sqrt();
-        let worst = z
-            .iter()
-            .max_by(|a, b| a.0.abs().total_cmp(&b.0.abs()))
-            .map(|(v, l)| format!("{:.1} ({l})", v.abs()))
-            .unwrap_or_default();
+    for g in eij::ident::groups::group_fits(p, result) {
         outln!(
-            "  {:<28} {:>5}  {:>6}  {:>5.2}  {}",
-            key,
-            n,
-            z.len(),
-            rms,
-            worst
+            "  {:<28} {:>5}  {:>6}  {:>5.2}  {:.1} ({})",
+            g.label(),
+            g.tests,
+            g.values,
+            g.rms_z,
+            g.max_abs_z.0,
+            g.max_abs_z.1
         );
     }
-}
-
-/// The set acceleration as written in labels: `5`, `2.5`.
-fn short_accel(t: &eij::ident::TestCase) -> String {
-    let s = format!("{:.2}", t.circle.accel_m_s2);
-    s.trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
 /// Median simulated/measured before and after over the values beyond 3σ.

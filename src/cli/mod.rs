@@ -27,6 +27,7 @@ macro_rules! errln {
 }
 
 mod advice;
+pub mod compare;
 mod compensation;
 pub mod console;
 pub mod evaluate;
@@ -74,6 +75,9 @@ enum Command {
     Fe(fe::FeArgs),
     /// Identify stiffness reduction factors from measured EIJ (defaults: the bundled demo).
     Identify(identify::IdentifyArgs),
+    /// Which of several candidate machine models the measured EIJ support: each identified on
+    /// the same tests, ranked by BIC, with χ² tests, hold-out and a verdict in words.
+    Compare(compare::CompareArgs),
     /// Re-run stored known-good identifications and fail if a result drifts.
     Verify(identify::VerifyArgs),
     /// EIJ over a grid of axis positions (compensation table).
@@ -102,6 +106,7 @@ impl Cli {
             Command::Export(args) => export::run(args),
             Command::Fe(args) => fe::run(args),
             Command::Identify(args) => identify::run(args),
+            Command::Compare(args) => compare::run(args),
             Command::Verify(args) => identify::verify(args),
             Command::Map(args) => map::run(args),
             Command::Report(args) => report::run(args),

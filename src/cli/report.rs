@@ -12,7 +12,7 @@ use eij::report::{self, ReportRequest};
     clap::ArgGroup::new("inputs")
         .required(true)
         .multiple(true)
-        .args(["measured", "identify_report", "moves", "maps", "history"])
+        .args(["measured", "identify_report", "compare_report", "moves", "maps", "history"])
 ))]
 pub struct ReportArgs {
     /// R-Test CSV files or folders of them (folders: every *.csv, sorted; a folder's
@@ -24,6 +24,10 @@ pub struct ReportArgs {
     /// dates) are compared side by side, in the order given.
     #[arg(long, value_name = "FILE.json")]
     identify_report: Vec<PathBuf>,
+    /// Report JSON of `eij compare --report`: the model comparison first (verdict, candidates
+    /// with s, χ² test, BIC, AIC, hold-out), each candidate's identification with the others.
+    #[arg(long, value_name = "FILE.json")]
+    compare_report: Option<PathBuf>,
     /// Simulated move CSVs (`eij simulate move`), one figure each.
     #[arg(long = "move", value_name = "FILE.csv", num_args = 1..)]
     moves: Vec<PathBuf>,
@@ -51,6 +55,7 @@ pub fn run(args: ReportArgs) -> anyhow::Result<()> {
     let page = report::generate(&ReportRequest {
         measured: args.measured,
         identify_reports: args.identify_report,
+        compare_report: args.compare_report,
         moves: args.moves,
         extra_figures: map_figures(&args.maps)?,
         history: args.history,

@@ -28,14 +28,21 @@
 //! [`uncertainty`], [`design`], [`validation`], [`settings`] (every default), [`measured`]
 //! (reading measured EIJ), [`config`] and [`report`] (files), and [`identify`], which runs them
 //! in order; [`stiffness`] gives the identified stiffness set as a table, [`verdict`] how to
-//! read the result (each parameter's standing, the χ² test).
+//! read the result (each parameter's standing, the χ² test), [`groups`] how well each plane and
+//! circle centre is reproduced, [`holdout`] leaving one circle centre out, and [`compare`] which
+//! of several candidate models the data support (BIC, AIC, a verdict in words;
+//! [`compare_report`] its file).
 
 mod acceptance;
 mod builder;
+pub mod compare;
+pub mod compare_report;
 pub mod config;
 pub mod design;
 pub mod diagnosis;
 mod error;
+pub mod groups;
+pub mod holdout;
 pub(crate) mod identifiability;
 pub(crate) mod lm;
 pub mod measured;

@@ -212,6 +212,9 @@ pub struct IdentReport {
     /// ([`crate::machine::stiffness`]; absent from reports of older versions).
     #[serde(default)]
     pub stiffness: Option<Vec<StiffnessRow>>,
+    /// The elastic bodies: modes kept, frequencies, identified stiffness factor.
+    #[serde(default)]
+    pub elastic_bodies: Vec<super::stiffness::ElasticBodyReport>,
 }
 
 /// One parameter of [`IdentReport`].
@@ -485,6 +488,7 @@ impl IdentReport {
             settings: Some(problem.settings().into()),
             tests,
             stiffness: Some(super::stiffness::identified_table(problem, result).rows),
+            elastic_bodies: super::stiffness::elastic_bodies(problem, result),
         }
     }
 

@@ -91,6 +91,61 @@ pub fn machine_table(machine: &Machine) -> (StiffnessTable, Vec<String>) {
     )
 }
 
+/// An elastic body in the identification report: what the model keeps of it, its elastic
+/// frequencies and its stiffness factor as identified (docs/identification-files.md).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ElasticBodyReport {
+    /// The body's name.
+    pub body: String,
+    /// Elastic coordinates kept by the reduction.
+    pub modes: usize,
+    /// Elastic free-free frequencies of the reduced body with its identified factor, Hz,
+    /// ascending (rigid modes left out).
+    pub frequencies_hz: Vec<f64>,
+    /// Its stiffness factor (identified, or as in the file).
+    pub factor: f64,
+    /// Standard error of the factor; null when not identified or not determined.
+    #[serde(default)]
+    pub std_err: Option<f64>,
+    /// The factor ± 3 standard errors taken in 1/p and mapped back (high null: unbounded;
+    /// [`super::verdict::factor_interval`]).
+    #[serde(default)]
+    pub interval_3sigma: Option<(f64, Option<f64>)>,
+    /// The parameter that set it (`column.stiffness`), if identified.
+    #[serde(default)]
+    pub parameter: Option<String>,
+}
+
+/// The elastic bodies of an identification's result, in the machine's body order.
+pub fn elastic_bodies(problem: &Problem, result: &IdentResult) -> Vec<ElasticBodyReport> {
+    let table = identified_table(problem, result);
+    table
+        .bodies
+        .iter()
+        .map(|b| {
+            let frequencies_hz = result
+                .machine
+                .bodies()
+                .iter()
+                .find(|x| x.name == b.body)
+                .and_then(|x| x.elastic())
+                .map(|e| e.frequencies_hz())
+                .unwrap_or_default();
+            ElasticBodyReport {
+                body: b.body.clone(),
+                modes: b.modes,
+                frequencies_hz,
+                factor: b.factor,
+                std_err: b.factor_std_err,
+                interval_3sigma: b.factor_std_err.and_then(|se| {
+                    super::verdict::factor_interval(b.factor, se, super::settings::INTERVAL_SIGMAS)
+                }),
+                parameter: b.parameter.clone(),
+            }
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -19,8 +19,8 @@ pub use super::page::Figure;
 use super::page::{anchor, escape, Page};
 use super::verdict::{self, LoadedIdent};
 use super::{
-    certificate, circle_group, compare, diagnosis_html, ident_html, move_svg, short, Conditions,
-    MoveData, ReportError,
+    certificate, circle_group, compare, diagnosis_html, ident_html, model_compare, move_svg, short,
+    Conditions, MoveData, ReportError,
 };
 use crate::axes::Plane;
 use crate::ident::report::IdentReport;
@@ -46,6 +46,19 @@ pub struct ReportRequest {
     pub history: Vec<PathBuf>,
     /// The report folder (created if missing; an existing file there is refused).
     pub out_dir: PathBuf,
+    /// A model comparison (`eij compare --report`): its verdict and candidates first, their
+    /// identifications with the others.
+    pub compare_report: Option<PathBuf>,
+}
+
+/// The page letter of the identification at `index`: `A` … `Z`, then `A1` ….
+fn letter(index: usize) -> String {
+    let letter = char::from_u32('A' as u32 + (index % 26) as u32).unwrap_or('?');
+    if index < 26 {
+        letter.to_string()
+    } else {
+        format!("{letter}{}", index / 26)
+    }
 }
 
 /// Reads an identify report, naming the file and the key on failure.
@@ -62,14 +75,8 @@ fn read_identification(path: &Path, index: usize) -> Result<LoadedIdent, ReportE
         source_name: name,
         message: e.to_string(),
     })?;
-    let letter = char::from_u32('A' as u32 + (index % 26) as u32).unwrap_or('?');
-    let letter = if index < 26 {
-        letter.to_string()
-    } else {
-        format!("{letter}{}", index / 26)
-    };
     Ok(LoadedIdent {
-        letter,
+        letter: letter(index),
         path: path.to_path_buf(),
         report,
     })
@@ -129,12 +136,25 @@ pub fn generate(req: &ReportRequest) -> Result<PathBuf, ReportError> {
         .enumerate()
         .map(|(i, g)| circle_group::figures(g, i + 1, &scale))
         .collect::<Result<Vec<_>, _>>()?;
-    let idents = req
+    let mut idents = req
         .identify_reports
         .iter()
         .enumerate()
         .map(|(i, p)| read_identification(p, i))
         .collect::<Result<Vec<_>, _>>()?;
+    let comparison = match &req.compare_report {
+        Some(path) => {
+            let r = model_compare::read(path)?;
+            let candidates = model_compare::idents(&r, path, idents.len(), letter);
+            let letters: Vec<(String, String)> = candidates
+                .iter()
+                .map(|(label, id)| (label.clone(), id.letter.clone()))
+                .collect();
+            idents.extend(candidates.into_iter().map(|(_, id)| id));
+            Some((r, letters))
+        }
+        None => None,
+    };
     let ident_figures = idents
         .iter()
         .map(ident_html::figure)
@@ -173,6 +193,9 @@ pub fn generate(req: &ReportRequest) -> Result<PathBuf, ReportError> {
     };
 
     let mut page = Page::default();
+    if let Some((r, letters)) = &comparison {
+        model_compare::section(&mut page, r, letters);
+    }
     verdict_section(&mut page, &idents, &suite);
     if let Some(e) = &diagnosis_error {
         page.push(&format!(
@@ -241,6 +264,7 @@ pub fn generate(req: &ReportRequest) -> Result<PathBuf, ReportError> {
 
     let mut inputs: Vec<&Path> = files.iter().map(PathBuf::as_path).collect();
     inputs.extend(req.identify_reports.iter().map(PathBuf::as_path));
+    inputs.extend(req.compare_report.iter().map(PathBuf::as_path));
     inputs.extend(req.moves.iter().map(PathBuf::as_path));
     let out = &req.out_dir;
     let created = match std::fs::create_dir(out) {

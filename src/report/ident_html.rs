@@ -59,6 +59,7 @@ pub(crate) fn details(page: &mut Page, id: &LoadedIdent, fig: &Figure) {
     h.push_str(&super::stiffness_html(
         rep.stiffness.as_deref().unwrap_or_default(),
     ));
+    h.push_str(&super::stiffness::elastic_bodies_html(&rep.elastic_bodies));
     page.push(&h);
     page.figure(fig);
     let mut h = String::new();

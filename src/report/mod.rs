@@ -10,6 +10,7 @@
 //! cw/ccw pairs (measured::suite) ─► circle_group ─► polar_svg (ISO 230-4 circle plot, µm rings)
 //!                                             └► polar::out_of_plane_svg (cw and ccw over φ)
 //! identify reports ─► verdict (standing, χ², warnings), compare (side by side)
+//! eij compare report ─► model_compare (verdict, candidates' criteria; their identifications join the rest)
 //! measured::suite::diagnose ─► diagnosis_html (per test and source, beside the circle plot)
 //!                           └► certificate (one A4 page: machine, date, tolerances, pass/fail)
 //! measured::history (dated runs) ─► history_html (terms and EIJ over time, trend plots, drift)
@@ -38,6 +39,7 @@ pub(crate) mod ident_html;
 pub(crate) mod ident_plot;
 pub mod labels;
 pub(crate) mod map_plot;
+pub(crate) mod model_compare;
 pub(crate) mod move_plot;
 pub(crate) mod page;
 pub(crate) mod polar;

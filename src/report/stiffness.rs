@@ -51,3 +51,52 @@ pub fn stiffness_html(rows: &[StiffnessRow]) -> String {
     }
     h
 }
+
+/// The elastic bodies of an identification as an HTML section: per body the elastic
+/// coordinates kept, the first elastic frequencies with the identified factor, the factor with
+/// its standard error and 3σ interval. Empty for none (a rigid machine, or an older report).
+pub fn elastic_bodies_html(bodies: &[crate::ident::stiffness::ElasticBodyReport]) -> String {
+    /// Frequencies listed per body (the rest are counted).
+    const LISTED: usize = 6;
+    let mut h = String::new();
+    if bodies.is_empty() {
+        return h;
+    }
+    let _ = writeln!(
+        h,
+        "<h3>Elastic bodies</h3>\n<table>\n<tr><th class=\"l\">body</th><th>modes kept</th>\
+         <th class=\"l\">elastic free-free frequencies (Hz, with the factor)</th><th>stiffness factor</th>\
+         <th>± std err</th><th>3σ interval (in 1/p)</th><th class=\"l\">parameter</th></tr>"
+    );
+    for b in bodies {
+        let mut f: Vec<String> = b
+            .frequencies_hz
+            .iter()
+            .take(LISTED)
+            .map(|x| format!("{x:.0}"))
+            .collect();
+        if b.frequencies_hz.len() > LISTED {
+            f.push(format!("… ({} in all)", b.frequencies_hz.len()));
+        }
+        let _ = writeln!(
+            h,
+            "<tr><td class=\"l\">{}</td><td>{}</td><td class=\"l\">{}</td><td>{:.4}</td><td>{}</td>\
+             <td>{}</td><td class=\"l\">{}</td></tr>",
+            escape(&b.body),
+            b.modes,
+            escape(&f.join(", ")),
+            b.factor,
+            b.std_err.map_or("–".into(), |s| format!("{s:.4}")),
+            b.interval_3sigma
+                .map_or("–".into(), crate::ident::verdict::format_interval),
+            b.parameter.as_deref().map_or("not identified".into(), escape)
+        );
+    }
+    let _ = writeln!(
+        h,
+        "</table>\n<p class=\"note\">The factor scales the body's whole FE stiffness (E and G alike); \
+         every frequency scales with its square root. A factor far from 1 says the FE model or the \
+         joints that hold the body are wrong.</p>"
+    );
+    h
+}
