@@ -1,7 +1,8 @@
-//! `eij evaluate-move FILE.csv --axis J [--json]`: EIJ of the moved axis from a positioning move.
+//! `eij evaluate-move FILE.csv --axis J [--nominal] [--json]`: EIJ of the moved axis from a
+//! positioning move.
 
 use eij::axes::Axis;
-use eij::measured::moves::evaluate_move;
+use eij::measured::moves::{evaluate_move_against, Reference};
 use std::path::PathBuf;
 
 /// Arguments of `eij evaluate-move`.
@@ -13,6 +14,11 @@ pub struct EvaluateMoveArgs {
     /// The moved axis: x, y or z.
     #[arg(long)]
     axis: Axis,
+    /// Measure the deviation against the nominal path (external − `<i>_set_mm` of every axis)
+    /// instead of external − internal: what a compensation on the set points reduces, so that a
+    /// compensated move (`eij simulate move … --compensation`) shows the EIJ that remain.
+    #[arg(long)]
+    nominal: bool,
     /// JSON on standard output instead of the table.
     #[arg(long)]
     json: bool,
@@ -20,9 +26,20 @@ pub struct EvaluateMoveArgs {
 
 /// Runs `eij evaluate-move`.
 pub fn run(args: EvaluateMoveArgs) -> anyhow::Result<()> {
-    let m = evaluate_move(&args.file, args.axis)?;
+    let reference = if args.nominal {
+        Reference::Nominal
+    } else {
+        Reference::Internal
+    };
+    let m = evaluate_move_against(&args.file, args.axis, reference)?;
+    let deviation = match reference {
+        Reference::Internal => "external − internal",
+        Reference::Nominal => "external − nominal path",
+    };
     if args.json {
-        outln!("{}", serde_json::to_string_pretty(&m.to_json())?);
+        let mut json = m.to_json();
+        json["deviation"] = deviation.into();
+        outln!("{}", serde_json::to_string_pretty(&json)?);
         return Ok(());
     }
     outln!(
@@ -33,13 +50,20 @@ pub fn run(args: EvaluateMoveArgs) -> anyhow::Result<()> {
         m.peak_accel_m_s2
     );
     outln!(
-        "  {:<5} {:>10} {:>10}   (µm·s²/m)",
+        "  {:<5} {:>10} {:>10}   (µm·s²/m, deviation {deviation})",
         "EIJ",
         "value",
         "std err"
     );
     for (e, v) in &m.eij {
         outln!("  {:<5} {:>10.4} {:>10.4}", e.name(), v.value, v.std_err);
+    }
+    if reference == Reference::Nominal {
+        let j = m.axis.letter();
+        outln!(
+            "  (E{j}{j} against the nominal path holds axis {}'s own following error too)",
+            m.axis
+        );
     }
     Ok(())
 }

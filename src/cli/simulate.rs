@@ -109,7 +109,7 @@ fn corrections(comp: &Compensated, cl: &ClosedLoop, run: &eij::sim::Run) -> Vec<
 /// What `--plot` draws.
 enum PlotKind {
     Circle { radius_mm: f64 },
-    Move(JerkLimitedMove),
+    Move(Box<MoveData>),
 }
 
 #[derive(Debug, clap::Args)]
@@ -253,7 +253,7 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
             let j = positive("jerk-m-s3", m.jerk_m_s3)?;
             let mv = JerkLimitedMove::new(m.axis, m.distance_mm * 1e-3, v, a, j);
             check_samples(&m.common, &mv, None)?;
-            run_move(&m.common, &mv)?;
+            let deviation = run_move(&m.common, &mv)?;
             // After the run, so that a refused move gives one error line only.
             super::console::status(format_args!(
                 "move {}: {:.3} mm, peak velocity {:.4} m/s, peak set acceleration {:.3} m/s², {:.4} s",
@@ -263,12 +263,15 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
                 mv.peak_accel_m_s2,
                 mv.motion_s()
             ));
+            super::console::status(format_args!("{deviation}"));
             Ok(())
         }
     }
 }
 
-fn run_move(common: &Common, mv: &JerkLimitedMove) -> anyhow::Result<()> {
+/// Simulates the move (and, with a compensation, the same move without it); returns the
+/// console line of the TCP's deviation from the nominal path.
+fn run_move(common: &Common, mv: &JerkLimitedMove) -> anyhow::Result<String> {
     let (machine, pose, table) = common.load()?;
     let Some(i) = machine.axes().iter().position(|a| a.axis == mv.axis) else {
         bail!("{}: the machine has no axis {}", machine.source(), mv.axis);
@@ -298,13 +301,56 @@ fn run_move(common: &Common, mv: &JerkLimitedMove) -> anyhow::Result<()> {
     drop(spinner);
     let cl = &segments[0].closed_loop;
     let correction = comp.as_ref().map(|c| corrections(c, cl, &run));
-    write_output_files(
-        common,
-        cl,
-        run,
-        PlotKind::Move(mv.clone()),
-        cond,
-        correction,
+    let mut data = MoveData::from_run(cl, &run, mv.axis, cond.source.clone())?.planned(mv);
+    let (with, without) = if let Some(c) = &correction {
+        data = data.nominal(cl, &run, c)?;
+        // The same move without the table: what the compensation is measured against.
+        let spinner = super::console::Progress::spinner("simulate: the move without compensation");
+        let plain = eij::sim::simulate_segments(&segments, mv)?;
+        drop(spinner);
+        data.uncompensated_um = MoveData::from_run(cl, &plain, mv.axis, String::new())?
+            .nominal(cl, &plain, &[])?
+            .compensated_um;
+        (
+            peaks_um(&data.compensated_um),
+            peaks_um(&data.uncompensated_um),
+        )
+    } else {
+        // The plot keeps the structural deviation ext − int; the console states TCP − set.
+        let path = data.clone().nominal(cl, &run, &[])?.compensated_um;
+        (Vec::new(), peaks_um(&path))
+    };
+    let kind = PlotKind::Move(Box::new(data));
+    write_output_files(common, cl, run, kind, cond, correction)?;
+    Ok(path_deviation_line(&with, &without))
+}
+
+/// The largest |value| of each axis's series.
+fn peaks_um(series: &[(Axis, Vec<f64>)]) -> Vec<(Axis, f64)> {
+    series
+        .iter()
+        .map(|(b, d)| (*b, d.iter().fold(0.0, |m: f64, x| m.max(x.abs()))))
+        .collect()
+}
+
+/// The console line of the TCP's peak deviation from the nominal path per other axis, with
+/// the compensation's reduction factor when it has one.
+fn path_deviation_line(with: &[(Axis, f64)], without: &[(Axis, f64)]) -> String {
+    let parts: Vec<String> = without
+        .iter()
+        .map(|(b, w)| match with.iter().find(|(a, _)| a == b) {
+            Some((_, c)) => format!("{b} {w:.3} → {c:.3} µm ({:.0}×)", w / c),
+            None => format!("{b} {w:.3} µm"),
+        })
+        .collect();
+    let how = if with.is_empty() {
+        "without compensation"
+    } else {
+        "without → with compensation"
+    };
+    format!(
+        "TCP deviation from the nominal path (peak |TCP − set|), {how}: {}",
+        parts.join(", ")
     )
 }
 
@@ -434,13 +480,7 @@ fn write_output_files(
             };
             Some((path, CircleView::new(&series, &eval)?.magnified_svg(&cond)?))
         }
-        (Some(path), PlotKind::Move(mv)) => {
-            let mut data = MoveData::from_run(cl, &run, mv.axis, cond.source.clone())?.planned(&mv);
-            if let Some(c) = &opts.correction {
-                data = data.nominal(cl, &run, c)?;
-            }
-            Some((path, move_svg(&data, &cond)?))
-        }
+        (Some(path), PlotKind::Move(data)) => Some((path, move_svg(&data, &cond)?)),
     };
     let mut files: Vec<(&std::path::Path, &[u8])> = vec![(&common.out, &bytes)];
     if let Some((path, svg)) = &plot {

@@ -10,8 +10,23 @@ use crate::rtest::moves::{evaluate_record, MoveEij, MoveError, MoveRecord};
 /// Most samples read from one move file (100 s at 10 kHz).
 pub const MAX_SAMPLES: usize = 1_000_000;
 
-/// Reads a move of axis `axis` (docs/commands.md columns plus the set point of the moved axis).
-pub fn read(path: &Path, axis: Axis) -> Result<MoveRecord, MoveError> {
+/// What a move's deviation is measured against.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Reference {
+    /// The axes' own readings: external − internal (`<i>_int_mm`), the structural deviation,
+    /// which a compensation on the set points does not change.
+    #[default]
+    Internal,
+    /// The nominal path: external − `<i>_set_mm` of every axis, the TCP's deviation from the
+    /// path that was asked for, which is what a compensation reduces (`eij simulate …
+    /// --compensation` keeps the nominal path in `<i>_set_mm`).
+    Nominal,
+}
+
+/// Reads a move of axis `axis` (docs/commands.md columns plus the set point of the moved axis);
+/// with [`Reference::Nominal`] the deviation's reference columns (the record's `int_mm`) are
+/// the nominal path `<i>_set_mm` of every axis.
+pub fn read(path: &Path, axis: Axis, reference: Reference) -> Result<MoveRecord, MoveError> {
     let file = path.display().to_string();
     let err = |at: String, message: String| MoveError {
         file: file.clone(),
@@ -35,7 +50,15 @@ pub fn read(path: &Path, axis: Axis) -> Result<MoveRecord, MoveError> {
         col(name).ok_or_else(|| err("header".into(), format!("missing column '{name}'")))
     };
     let t_col = need("t_s")?;
-    let int_cols = Axis::ALL.map(|a| need(&format!("{a}_int_mm")));
+    let int_cols = Axis::ALL.map(|a| match reference {
+        Reference::Internal => need(&format!("{a}_int_mm")),
+        Reference::Nominal => col(&format!("{a}_set_mm")).ok_or_else(|| {
+            err(
+                "header".into(),
+                format!("missing column '{a}_set_mm' (the nominal path, which --nominal measures against)"),
+            )
+        }),
+    });
     let ext_cols = Axis::ALL.map(|a| need(&format!("{a}_ext_mm")));
     let [ix, iy, iz] = int_cols;
     let [ex, ey, ez] = ext_cols;
@@ -144,8 +167,18 @@ pub fn read(path: &Path, axis: Axis) -> Result<MoveRecord, MoveError> {
 }
 
 /// Evaluates a move of axis `axis` recorded in `path` (docs/commands.md columns plus the set point of
-/// the moved axis).
+/// the moved axis): the deviation external − internal.
 pub fn evaluate_move(path: &Path, axis: Axis) -> Result<MoveEij, MoveError> {
-    let rec = read(path, axis)?;
+    evaluate_move_against(path, axis, Reference::Internal)
+}
+
+/// Evaluates a move of axis `axis` recorded in `path`, its deviation measured against
+/// `reference`.
+pub fn evaluate_move_against(
+    path: &Path,
+    axis: Axis,
+    reference: Reference,
+) -> Result<MoveEij, MoveError> {
+    let rec = read(path, axis, reference)?;
     evaluate_record(&rec, path.display().to_string(), axis)
 }

@@ -146,10 +146,10 @@ pub(crate) fn figures(
     );
     let lines = vec![
         conditions.clone(),
-        format!(
-            "radial deviation ρ − r about the least-squares centre of cw and ccw together · rings every {} µm · one scale in every circle plot",
-            short(scale.ring_um, 3)
-        ),
+        "radial deviation ρ − r about the least-squares centre of cw and ccw together · one \
+         scale in every circle plot"
+            .to_string(),
+        scale.rings_key(),
     ];
     let (a, b) = r.plane.axes();
     let fig = PolarFigure {

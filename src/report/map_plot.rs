@@ -85,14 +85,27 @@ pub fn map_svg(
             )
         })
         .collect();
-    let lines = vec![format!(
-        "harmonic steady state, same evaluation as measured data · other axes: {}",
-        if fixed.is_empty() {
-            "none".to_string()
-        } else {
-            fixed.join(", ")
-        }
-    )];
+    let ranges = shared_ranges(
+        &params
+            .iter()
+            .map(|e| points.iter().map(|p| p.eij[e]).collect::<Vec<f64>>())
+            .collect::<Vec<_>>(),
+    );
+    let span = ranges.first().map_or(0.0, |(lo, hi)| hi - lo);
+    let lines = vec![
+        format!(
+            "harmonic steady state, same evaluation as measured data · other axes: {}",
+            if fixed.is_empty() {
+                "none".to_string()
+            } else {
+                fixed.join(", ")
+            }
+        ),
+        format!(
+            "one scale in every panel: each spans {} µm·s²/m about its own middle, so that slopes compare",
+            short(span, 3)
+        ),
+    ];
     let xs: Vec<f64> = points.iter().map(|p| p.position_m[x_axis] * 1e3).collect();
     let (x0, x1) = svg::padded_range(xs.iter().copied(), 0.02);
     let header_px = 16 + 30 + 22 * lines.len() as u32 + 6;
@@ -116,8 +129,7 @@ pub fn map_svg(
                 };
                 legend.push(Entry::new(label, PALETTE[g % PALETTE.len()], Mark::Line));
             }
-            for (cell, e) in cells.iter().zip(params.iter()) {
-                let (lo, hi) = svg::padded_range(points.iter().map(|p| p.eij[e]), 0.1);
+            for ((cell, e), &(lo, hi)) in cells.iter().zip(params.iter()).zip(&ranges) {
                 let mut chart = ChartBuilder::on(cell)
                     .margin(10)
                     .caption(format!("{e} / (µm·s²/m)"), (svg::FONT, svg::TEXT_SIZE))
@@ -149,4 +161,68 @@ pub fn map_svg(
             Ok(())
         },
     )
+}
+
+/// The value range of each panel: one span for all (the largest spread of any panel, padded
+/// by 10 % a side), each about the middle of its own values, so that a panel whose values
+/// barely change draws flat instead of stretched to the panel's height.
+pub(crate) fn shared_ranges(panels: &[Vec<f64>]) -> Vec<(f64, f64)> {
+    let extent = |v: &[f64]| {
+        v.iter()
+            .filter(|x| x.is_finite())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &x| {
+                (lo.min(x), hi.max(x))
+            })
+    };
+    let spread = panels
+        .iter()
+        .map(|v| extent(v))
+        .filter(|(lo, hi)| lo.is_finite() && hi.is_finite())
+        .map(|(lo, hi)| hi - lo)
+        .fold(0.0, f64::max);
+    let largest = panels
+        .iter()
+        .flat_map(|v| v.iter())
+        .filter(|x| x.is_finite())
+        .fold(0.0, |m: f64, x| m.max(x.abs()));
+    // All panels constant: a span of a fifth of the largest value (or 1) shows them flat.
+    let span = if spread > 1e-12 * largest.max(1.0) {
+        spread * 1.2
+    } else if largest > 0.0 {
+        0.2 * largest
+    } else {
+        2.0
+    };
+    panels
+        .iter()
+        .map(|v| {
+            let (lo, hi) = extent(v);
+            let mid = if lo.is_finite() { 0.5 * (lo + hi) } else { 0.0 };
+            (mid - 0.5 * span, mid + 0.5 * span)
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::shared_ranges;
+
+    #[test]
+    fn panels_share_one_span_and_hold_their_values() {
+        // Issue 29 item 9: EZZ spanning −0.3437…−0.3441 beside EXX spanning 0.05 looked like a
+        // strong trend on its own scale. One span for all: the largest spread, padded.
+        let ezz = vec![-0.3437, -0.3439, -0.3441];
+        let exx = vec![-0.53, -0.51, -0.48];
+        let r = shared_ranges(&[ezz.clone(), exx.clone()]);
+        let span = 0.05 * 1.2;
+        for (v, (lo, hi)) in [ezz, exx].iter().zip(&r) {
+            assert!((hi - lo - span).abs() < 1e-12, "{lo}…{hi}");
+            assert!(v.iter().all(|x| lo < x && x < hi));
+        }
+        // EZZ's 0.0004 fill 0.7 % of its panel's height, not all of it.
+        assert!(0.0004 / (r[0].1 - r[0].0) < 0.01);
+        // Constant panels get a span of their own size, never zero.
+        let c = shared_ranges(&[vec![0.5, 0.5], vec![0.0]]);
+        assert!(c.iter().all(|(lo, hi)| (hi - lo - 0.1).abs() < 1e-12));
+    }
 }

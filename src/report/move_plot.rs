@@ -42,6 +42,10 @@ pub struct MoveData {
     /// states its peak velocity, acceleration and jerk (the numbers `eij simulate move`
     /// prints) instead of estimates from the samples.
     pub plan: Option<JerkLimitedMove>,
+    /// The TCP's deviation from the nominal path (TCP − set) of the other axes in the same move
+    /// simulated without the compensation, µm (`eij simulate move --compensation` runs both):
+    /// drawn as "without compensation" in place of the structural cross-talk.
+    pub uncompensated_um: Vec<(Axis, Vec<f64>)>,
 }
 
 impl MoveData {
@@ -138,6 +142,7 @@ impl MoveData {
             axis,
             compensated_um,
             plan: None,
+            uncompensated_um: Vec::new(),
             set_mm: need("set_mm")?,
             int_mm: need("int_mm")?,
             acc_set_m_s2: need("acc_set_m_s2")?,
@@ -186,6 +191,7 @@ impl MoveData {
             cross_talk_um,
             compensated_um: Vec::new(),
             plan: None,
+            uncompensated_um: Vec::new(),
             source,
         })
     }
@@ -338,34 +344,47 @@ pub fn move_svg(data: &MoveData, cond: &Conditions) -> Result<String, ReportErro
         ),
         (
             "deviation / µm".to_string(),
-            data.cross_talk_um
-                .iter()
-                .zip([svg::EXTERNAL, svg::SECOND])
-                .map(|((b, v), c)| {
-                    let label = if data.compensated_um.is_empty() {
-                        format!("d{b} = {b}_ext − {b}_int")
-                    } else {
-                        format!("d{b} without compensation ({b}_ext − {b}_int)")
-                    };
-                    (label, c, series(v))
-                })
-                .chain(
-                    data.compensated_um
-                        .iter()
-                        .zip([svg::SET, svg::INTERNAL])
-                        .map(|((b, v), c)| {
-                            (
-                                format!("d{b} with compensation ({b}_ext − {b}_set)"),
-                                c,
-                                series(v),
-                            )
-                        }),
-                )
-                .collect(),
+            if data.uncompensated_um.is_empty() {
+                &data.cross_talk_um
+            } else {
+                &data.uncompensated_um
+            }
+            .iter()
+            .zip([svg::EXTERNAL, svg::SECOND])
+            .map(|((b, v), c)| {
+                let label = if !data.uncompensated_um.is_empty() {
+                    format!("d{b} without compensation (TCP − nominal path)")
+                } else if data.compensated_um.is_empty() {
+                    format!("d{b} = {b}_ext − {b}_int")
+                } else {
+                    format!("d{b} without compensation ({b}_ext − {b}_int)")
+                };
+                (label, c, series(v))
+            })
+            .chain(
+                data.compensated_um
+                    .iter()
+                    .zip([svg::SET, svg::INTERNAL])
+                    .map(|((b, v), c)| {
+                        (
+                            format!("d{b} with compensation (TCP − nominal path)"),
+                            c,
+                            series(v),
+                        )
+                    }),
+            )
+            .collect(),
             if data.compensated_um.is_empty() {
                 vec![
                     format!("cross-talk: TCP deviation of"),
                     format!("the other axes while {ax} moves"),
+                ]
+            } else if !data.uncompensated_um.is_empty() {
+                vec![
+                    format!("cross-talk while {ax} moves:"),
+                    format!("TCP − nominal path of the"),
+                    format!("same move without and with"),
+                    format!("the compensation table"),
                 ]
             } else {
                 vec![

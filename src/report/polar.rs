@@ -66,6 +66,18 @@ impl PolarScale {
         }
     }
 
+    /// What the rings mean, for a figure's header: `rings every 2 µm from −4 µm (inner) to
+    /// +4 µm (outer) · bold ring: the set circle (0)`.
+    pub(crate) fn rings_key(&self) -> String {
+        let outer = self.ring_um * self.rings as f64;
+        format!(
+            "rings every {} µm from −{} µm (inner) to +{} µm (outer) · bold ring: the set circle (0)",
+            short(self.ring_um, 3),
+            short(outer, 3),
+            short(outer, 3)
+        )
+    }
+
     /// µm per unit of drawn radius.
     fn um_per_unit(&self) -> f64 {
         self.ring_um * self.rings as f64 / HALF_SPAN
@@ -232,28 +244,25 @@ fn polar_panel(
             grey.stroke_width(1),
         ))?;
     }
+    // The rings carry no numbers: any angle of the band between the inner and the outer ring
+    // is crossed by the paths (and the set circle by all of them), so a label there sits on a
+    // trace. The step is written in the free corner beyond the outer ring (and in the
+    // figure's header with the range: rings_key).
     let n = scale.rings as i64;
-    let label_angle = 75f64.to_radians();
     for k in -n..=n {
-        let dev = k as f64 * scale.ring_um;
-        let r = scale.drawn(dev);
+        let r = scale.drawn(k as f64 * scale.ring_um);
         let style = if k == 0 {
             RGBColor(60, 60, 60).stroke_width(2)
         } else {
             grey.stroke_width(1)
         };
         chart.draw_series(LineSeries::new(ring(r), style))?;
-        let label = if k == 0 {
-            "0".to_string()
-        } else {
-            format!("{:+} µm", short(dev, 3))
-        };
-        chart.draw_series(std::iter::once(Text::new(
-            label,
-            (r * label_angle.cos() + 0.02, r * label_angle.sin()),
-            svg::text(svg::LABEL_SIZE - 1.0, RGBColor(90, 90, 90)),
-        )))?;
     }
+    chart.draw_series(std::iter::once(Text::new(
+        format!("ring = {} µm", short(scale.ring_um, 3)),
+        (0.95, lim - 0.04),
+        svg::text(svg::LABEL_SIZE - 1.0, RGBColor(90, 90, 90)),
+    )))?;
     let (a, b) = &fig.axes;
     let out = 1.0 + HALF_SPAN + 0.08;
     for (text, x, y) in [

@@ -51,7 +51,8 @@ pub struct MoveEij {
 pub struct MoveRecord {
     /// Time, s.
     pub t: Vec<f64>,
-    /// Internal readings x, y, z, mm.
+    /// The reference of the deviation x, y, z, mm: the internal readings, or the nominal path
+    /// when the move is measured against it (`eij evaluate-move --nominal`).
     pub int_mm: [Vec<f64>; 3],
     /// External readings x, y, z, mm.
     pub ext_mm: [Vec<f64>; 3],
