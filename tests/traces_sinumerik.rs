@@ -294,3 +294,32 @@ fn a_trace_gives_the_eij_of_the_contract_pair() {
         );
     }
 }
+
+/// A trace cut at every byte (and with any single byte replaced by a quote, `<` or a digit) is
+/// read or refused with an error naming the file, never a panic.
+#[test]
+fn a_trace_cut_anywhere_never_panics() {
+    let d = Scratch::new("sinumerik-cuts");
+    let xml = sinumerik(&SIGNALS, &recs(8));
+    write(&d, "c", "", COLUMNS);
+    let tests = expand_tests(&[d.path("c")]).unwrap();
+    let file = d.path("c/trace.xml");
+    let check = |bytes: &[u8]| {
+        std::fs::write(&file, bytes).unwrap();
+        if let Err(e) = tests[0].read_internal() {
+            let m = e.to_string();
+            assert!(m.contains("trace.xml") && !m.contains('\n'), "{m}");
+        }
+    };
+    let bytes = xml.as_bytes();
+    for cut in 0..=bytes.len() {
+        check(&bytes[..cut]);
+    }
+    for i in (0..bytes.len()).step_by(3) {
+        for b in [b'"', b'<', b'9'] {
+            let mut v = bytes.to_vec();
+            v[i] = b;
+            check(&v);
+        }
+    }
+}

@@ -349,3 +349,32 @@ fn a_trace_gives_the_eij_of_the_contract_pair() {
         assert!(r.ok, "{}", r.stderr);
     }
 }
+
+/// A trace cut at every byte (and with any single byte replaced by a digit, `;` or a line end)
+/// is read or refused with an error naming the file, never a panic.
+#[test]
+fn a_trace_cut_anywhere_never_panics() {
+    let d = Scratch::new("tnc-cuts");
+    let text = xy_rows(12);
+    write(&d, "c", "", "");
+    let tests = expand_tests(&[d.path("c")]).unwrap();
+    let file = d.path("c/cnc.sco");
+    let check = |bytes: &[u8]| {
+        std::fs::write(&file, bytes).unwrap();
+        if let Err(e) = tests[0].read_internal() {
+            let m = e.to_string();
+            assert!(m.contains("cnc.sco") && !m.contains('\n'), "{m}");
+        }
+    };
+    let bytes = text.as_bytes();
+    for cut in 0..=bytes.len() {
+        check(&bytes[..cut]);
+    }
+    for i in (0..bytes.len()).step_by(3) {
+        for b in [b'7', b';', b'\n', b'%'] {
+            let mut v = bytes.to_vec();
+            v[i] = b;
+            check(&v);
+        }
+    }
+}
