@@ -39,6 +39,15 @@ pub enum MeasuredError {
         /// What the CSV reader found.
         message: String,
     },
+    /// A controller trace (TNCscope, Sinumerik) that does not hold what its format promises or
+    /// what a circle test needs (channels, units, rows, well-formed XML).
+    #[error("{at}: {message}")]
+    Trace {
+        /// Where.
+        at: Location,
+        /// What is wrong.
+        message: String,
+    },
     /// Required columns are missing from the header.
     #[error(
         "{at}: missing column(s) {}{}",

@@ -8,6 +8,9 @@
 //! - `#` comment lines anywhere, blank lines, a UTF-8 byte-order mark, CRLF line ends;
 //! - a metadata block before the header: the header is the first line (of the first 200 that
 //!   are not comments) that holds every required column; the lines before it are skipped;
+//! - a units row right under the header (`[ms]`, `(µm)`, `mm` in the required columns, no
+//!   number among them): the units of the columns where `[columns]` states none, checked
+//!   against `[columns]` where it does (a conflict names file, line and column);
 //! - column names in any letter case, surrounded by spaces or quotes.
 //!
 //! What the files call the contract columns, and in which unit, comes from a [`ColumnMap`].
@@ -102,6 +105,9 @@ pub struct ColumnSpec {
     pub name: String,
     /// The unit of its values.
     pub unit: Unit,
+    /// Whether `[columns]` states the unit (else it is the contract's, and a units row under
+    /// the header may give it).
+    pub stated: bool,
 }
 
 /// One entry of `[columns]` as written: `x_int_mm = "X_ACT"` or
@@ -169,6 +175,7 @@ impl ColumnMap {
                     "empty column name".into(),
                 ));
             }
+            let stated = unit.is_some();
             let unit = match unit {
                 None => contract_unit,
                 Some(u) => {
@@ -192,6 +199,7 @@ impl ColumnMap {
                 ColumnSpec {
                     name: name.trim().to_string(),
                     unit,
+                    stated,
                 },
             );
         }
@@ -238,6 +246,7 @@ impl ColumnMap {
             .unwrap_or_else(|| ColumnSpec {
                 name: contract.to_string(),
                 unit: if contract == "t_s" { Unit::S } else { Unit::Mm },
+                stated: false,
             })
     }
 }
@@ -404,10 +413,26 @@ pub(crate) fn read_table(
             index[k] = i;
         }
     }
+    // A units row under the header (`[ms]`, `(µm)`, `mm`): the units where `[columns]` states
+    // none, checked against them where it does.
+    let mut factor: Vec<f64> = specs.iter().map(|s| s.unit.to_contract()).collect();
+    let mut first = match records.next() {
+        Some(r) => Some(r.map_err(|e| csv_error(name, &mut counter, e))?),
+        None => None,
+    };
+    if let Some(units) = first.as_ref().and_then(|r| units_row(r, &index)) {
+        let line = first.as_ref().map_or(0, |r| counter.line_of_record(r));
+        for (k, cell) in units.into_iter().enumerate() {
+            if let Some(cell) = cell {
+                factor[k] = row_unit(name, line, &specs[k], wanted[k], &cell)?.to_contract();
+            }
+        }
+        first = None;
+    }
     let mut columns = vec![Vec::new(); keys.len()];
     let mut row_lines = Vec::new();
     let mut decimal_comma = false;
-    for record in records {
+    for record in first.map(Ok).into_iter().chain(records) {
         let record = record.map_err(|e| csv_error(name, &mut counter, e))?;
         let line = counter.line_of_record(&record);
         for (k, col) in columns.iter_mut().enumerate() {
@@ -416,7 +441,7 @@ pub(crate) fn read_table(
             let comma = separator != b',';
             decimal_comma |= comma && text.contains(',');
             let value = parse_decimal(text, comma, name, line, &specs[k].name)?;
-            col.push(value * specs[k].unit.to_contract());
+            col.push(value * factor[k]);
         }
         row_lines.push(line);
     }
@@ -430,6 +455,77 @@ pub(crate) fn read_table(
             header_line,
         },
     })
+}
+
+/// The unit text of a units-row cell: `[ms]`, `(µm)` or a bare unit name; `None` for a cell
+/// that is no unit (a number, other text).
+fn unit_text(cell: &str) -> Option<String> {
+    let t = cell.trim();
+    let inner = t
+        .strip_prefix('[')
+        .and_then(|s| s.strip_suffix(']'))
+        .or_else(|| t.strip_prefix('(').and_then(|s| s.strip_suffix(')')));
+    match inner {
+        Some(u) if !u.trim().is_empty() && parse_number(u.trim(), true).is_err() => {
+            Some(u.trim().to_string())
+        }
+        Some(_) => None,
+        None => Unit::parse(t).map(|_| t.to_string()),
+    }
+}
+
+/// The unit texts of the wanted columns (`index`) when `record` is a units row: no wanted
+/// cell is a number and at least one is a unit; an empty cell gives no unit.
+fn units_row(record: &csv::StringRecord, index: &[usize]) -> Option<Vec<Option<String>>> {
+    let cells: Vec<&str> = index.iter().map(|&i| record.get(i).unwrap_or("")).collect();
+    let units: Vec<Option<String>> = cells.iter().map(|c| unit_text(c)).collect();
+    let is_row = units.iter().any(Option::is_some)
+        && cells
+            .iter()
+            .zip(&units)
+            .all(|(c, u)| u.is_some() || c.trim().is_empty());
+    is_row.then_some(units)
+}
+
+/// The unit a units-row cell gives column `spec` (contract column `contract`): known, of the
+/// column's kind, and the one `[columns]` states if it states one.
+fn row_unit(
+    source: &str,
+    line: u64,
+    spec: &ColumnSpec,
+    contract: &str,
+    text: &str,
+) -> Result<Unit, MeasuredError> {
+    let time = contract == "t_s";
+    let bad = |message: String| MeasuredError::BadValue {
+        at: Location::file_line(source, line),
+        column: spec.name.clone(),
+        message,
+    };
+    let expected = if time { "s, ms or us" } else { "m, mm or um" };
+    let unit = match Unit::parse(text) {
+        Some(u) if u.is_time() == time => u,
+        Some(_) => {
+            return Err(bad(format!(
+                "the units row gives '{}', no unit of {} (expected {expected})",
+                quote_cell(text),
+                if time { "time" } else { "length" }
+            )))
+        }
+        None => {
+            return Err(bad(format!(
+                "the units row gives '{}', not a unit eij reads (expected {expected})",
+                quote_cell(text)
+            )))
+        }
+    };
+    if spec.stated && unit != spec.unit {
+        return Err(bad(format!(
+            "the units row says {unit}, rtest.toml [columns] says {}",
+            spec.unit
+        )));
+    }
+    Ok(unit)
 }
 
 /// Turns a CSV reader error into a one-line error naming the line.

@@ -1,7 +1,8 @@
 //! What was measured, read from files: R-Test circle-test series in their CSV dialects and
 //! column maps ([`layout`], [`series`]), a folder's test conditions (`rtest.toml`, [`conditions`])
 //! and the tests they make ([`inputs`]), two-system recordings ([`recording`]), EIJ tables
-//! ([`table`]) and the evaluation JSON ([`json`]), positioning moves ([`moves`]); and the
+//! ([`table`]) and the evaluation JSON ([`json`]), positioning moves ([`moves`]), controller traces
+//! as internal recordings (TNCscope, Sinumerik: [`traces`]); and the
 //! evaluation of a command's measured tests as one suite ([`suite`]: clocks aligned, each test
 //! evaluated by [`crate::rtest`] at its conditions, cw/ccw pairs).
 //!
@@ -33,5 +34,6 @@ pub(crate) mod recording;
 pub(crate) mod series;
 pub mod suite;
 pub mod table;
+pub mod traces;
 
 pub use error::MeasuredError;

@@ -23,6 +23,12 @@ impl CircleSeries {
     pub fn read_csv_with(path: impl AsRef<Path>, map: &ColumnMap) -> Result<Self, MeasuredError> {
         let path = path.as_ref();
         let bytes = read_file(path)?;
+        if super::traces::format_of(&bytes) != super::traces::Format::Delimited {
+            return Err(MeasuredError::Trace {
+                at: Location::source(&path.display().to_string()),
+                message: "a controller trace holds only the axes' own readings: pair it with the R-Test file in rtest.toml ([[test]] internal = this file, external = the R-Test file)".into(),
+            });
+        }
         Self::from_csv_bytes_with(&path.display().to_string(), &bytes, map)
     }
 

@@ -37,6 +37,10 @@ pub(crate) struct Recording {
     pub mm: [Vec<f64>; 3],
     /// File line of every row, where read from a file.
     pub lines: Option<Vec<u64>>,
+    /// Axes the file does not record (a controller trace of the two axes of the plane): their
+    /// column holds 0, the axis standing at the circle centre; a change of coordinates (the
+    /// circle centre subtracted) leaves them alone.
+    pub absent: [bool; 3],
 }
 
 impl Recording {
@@ -52,6 +56,7 @@ impl Recording {
             t_s,
             mm,
             lines: None,
+            absent: [false; 3],
         };
         r.check()?;
         Ok(r)
@@ -70,6 +75,7 @@ impl Recording {
             t_s,
             mm,
             lines: Some(lines),
+            absent: [false; 3],
         };
         r.check()?;
         Ok(r)
@@ -154,7 +160,7 @@ impl Recording {
 /// Four-point Lagrange weights for `t` on `times`: the first of the four samples and the
 /// weights; `None` unless `times[1] <= t <= times[n−2]`. `hint` is the previous answer's
 /// interval, walked from (successive calls mostly move forward).
-fn cubic_weights(times: &[f64], t: f64, hint: &mut usize) -> Option<(usize, [f64; 4])> {
+pub(crate) fn cubic_weights(times: &[f64], t: f64, hint: &mut usize) -> Option<(usize, [f64; 4])> {
     let n = times.len();
     if n < 4 || !(t >= times[1] && t <= times[n - 2]) {
         return None;

@@ -10,6 +10,7 @@ pub mod imperfect;
 pub mod mutation;
 pub mod random_machine;
 pub mod synth;
+pub mod traces;
 
 use eij::machine::Machine;
 use eij::mbs::Model;

@@ -151,7 +151,11 @@ pub fn evaluate_tests(inputs: &[TestInput], opts: &SuiteOptions) -> Result<Suite
             let data = match &input.data {
                 DataFiles::Single(_) => Data::Single(input.read_single()?),
                 DataFiles::Split { internal, external } => Data::Split {
-                    internal: super::recording::read_internal(internal, &input.internal_columns)?,
+                    internal: super::recording::read_internal(
+                        internal,
+                        &input.internal_columns,
+                        eval.plane,
+                    )?,
                     external: super::recording::read_external(external, &input.external_columns)?,
                 },
             };
