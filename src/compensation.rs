@@ -181,8 +181,10 @@ impl CompensationTable {
                 }
             })
             .collect();
-        // EIJ samples per parameter: (positions in mm, values), summed over the planes.
-        let mut sums: BTreeMap<Eij, (Vec<[f64; 3]>, Vec<f64>, Vec<u32>)> = BTreeMap::new();
+        // EIJ samples per parameter: positions in mm, values summed over the planes, and how
+        // many planes gave each.
+        type Samples = (Vec<[f64; 3]>, Vec<f64>, Vec<u32>);
+        let mut sums: BTreeMap<Eij, Samples> = BTreeMap::new();
         let planes: Vec<Plane> = Plane::ALL
             .into_iter()
             .filter(|p| machine.axis(p.axes().0).is_some() && machine.axis(p.axes().1).is_some())

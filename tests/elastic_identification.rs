@@ -238,7 +238,10 @@ fn the_default_set_recovers_the_column_and_the_guideways_of_the_flexible_demo() 
     }
     // 0.7 on an FE model is plausible: no warning names the column.
     assert!(
-        result.warnings.iter().all(|w| !w.contains("column")),
+        result
+            .warnings
+            .iter()
+            .all(|w| !w.to_string().contains("column")),
         "{:?}",
         result.warnings
     );
@@ -317,6 +320,7 @@ fn a_column_far_softer_than_its_fe_model_is_identified_with_a_warning() {
     let warning = result
         .warnings
         .iter()
+        .map(ToString::to_string)
         .find(|w| w.starts_with("column.stiffness = 0.3000 < 0.5"))
         .unwrap_or_else(|| panic!("{:?}", result.warnings));
     assert!(warning.contains("FE model") && warning.contains("joints"));

@@ -120,6 +120,7 @@ fn softer_feet_in_the_truth_are_said_as_a_model_mismatch() {
     let warning = result
         .warnings
         .iter()
+        .map(ToString::to_string)
         .find(|w| w.starts_with("model mismatch suspected"))
         .expect("the warning");
     assert!(
@@ -205,7 +206,7 @@ fn the_correct_model_gives_no_mismatch_warning() {
     assert!(result
         .warnings
         .iter()
-        .all(|w| !w.contains("model mismatch")));
+        .all(|w| !w.to_string().contains("model mismatch")));
     let json = report_json(&problem, &result);
     assert!(json["model_mismatch"].is_null());
     // Every truth lies inside its 3σ interval.

@@ -31,10 +31,14 @@ pub fn evaluate_warning(w: &Warning) -> String {
     }
 }
 
-/// A warning of the measured data read by `eij identify`, with the option that answers it.
-pub fn identify_warning(w: &Named) -> String {
-    match w.warning {
-        Warning::DefaultRadius { .. } => {
+/// A warning of `eij identify` (its own or of the measured data it read), with the option
+/// that answers it.
+pub fn identify_warning(w: &eij::ident::Warning) -> String {
+    match w {
+        eij::ident::Warning::Measured(Named {
+            warning: Warning::DefaultRadius { .. },
+            ..
+        }) => {
             format!("{w}; give --radius-mm or radius_mm in rtest.toml")
         }
         _ => w.to_string(),

@@ -255,10 +255,13 @@ fn run_identification(prep: &Prepared, quiet: bool) -> anyhow::Result<(IdentResu
     let mut result = result.map_err(super::advice::identify)?;
     result.warnings.splice(
         0..0,
-        prep.warnings.iter().map(super::advice::identify_warning),
+        prep.warnings
+            .iter()
+            .cloned()
+            .map(eij::ident::Warning::Measured),
     );
     for w in &result.warnings {
-        errln!("warning: {w}");
+        errln!("warning: {}", super::advice::identify_warning(w));
     }
     Ok((result, start.elapsed().as_secs_f64()))
 }
@@ -376,6 +379,11 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
         None => None,
     };
     let mut ident_report = report::IdentReport::new(&prep.problem, &result, &prep.provenance);
+    ident_report.warnings = result
+        .warnings
+        .iter()
+        .map(super::advice::identify_warning)
+        .collect();
     ident_report.validation = validation.as_ref().map(Into::into);
     ident_report.clocks = prep.clocks.iter().map(Into::into).collect();
     if !super::console::quiet() {

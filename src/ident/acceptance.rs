@@ -6,7 +6,7 @@ use super::identifiability::Analysis;
 use super::parameters::to_factor;
 use super::settings::{Settings, AT_BOUND_REL};
 use super::verdict::Implausible;
-use super::{IdentError, Identified, Problem};
+use super::{IdentError, Identified, Problem, Warning};
 use nalgebra::DVector;
 
 /// Refuses to start a fit the tests cannot carry: no parameter they determine, or fewer
@@ -112,19 +112,25 @@ pub(super) fn refusal(
 /// Warnings on identified factors: on a bound, or implausible ([`Implausible`]: a reduction
 /// factor stiffer than the catalogue or more than ten times softer, an elastic body's stiffness
 /// factor far from its FE model).
-pub(super) fn plausibility(parameters: &[Identified], settings: &Settings) -> Vec<String> {
+pub(super) fn plausibility(parameters: &[Identified], settings: &Settings) -> Vec<Warning> {
     let (lo, hi) = (settings.min_factor, settings.max_factor);
     parameters
         .iter()
         .filter(|q| q.identifiable)
         .filter_map(|q| {
             if q.at_bound {
-                Some(format!(
-                    "{} = {} ended on a bound of the factors [{lo}, {hi}]: the data want a value outside",
-                    q.name, q.value
-                ))
+                Some(Warning::AtBound {
+                    name: q.name.clone(),
+                    value: q.value,
+                    min: lo,
+                    max: hi,
+                })
             } else {
-                Implausible::of(&q.name, q.value).map(|why| why.warning(&q.name, q.value))
+                Implausible::of(&q.name, q.value).map(|why| Warning::Implausible {
+                    name: q.name.clone(),
+                    value: q.value,
+                    why,
+                })
             }
         })
         .collect()

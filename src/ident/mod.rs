@@ -58,6 +58,7 @@ pub mod stiffness;
 pub(crate) mod uncertainty;
 pub mod validation;
 pub mod verdict;
+mod warning;
 
 pub use crate::predict::{EijMap, SolverKind};
 pub use builder::Identification;
@@ -68,6 +69,7 @@ pub use problem::{Problem, TestCase};
 pub use settings::{MeasuredOptions, Method, Settings};
 pub use statics::{StaticTerms, Statics};
 pub use uncertainty::Uncertainty;
+pub use warning::Warning;
 
 use crate::machine::Machine;
 use nalgebra::{DMatrix, DVector};
@@ -169,7 +171,7 @@ pub struct IdentResult {
     /// significant terms; [`mismatch`]).
     pub model_mismatch: Option<mismatch::ModelMismatch>,
     /// Warnings (non-identifiable parameters, bounds, χ², plausibility, model mismatch).
-    pub warnings: Vec<String>,
+    pub warnings: Vec<Warning>,
     /// Notes (static terms not separable, reversal terms added).
     pub notes: Vec<String>,
     /// Why the fit must not be exported: it did not converge or ended on a bound.
@@ -243,10 +245,14 @@ pub fn identify(
         &fitted.edges,
         &names,
     );
-    let mut warnings: Vec<String> = analysis
+    let mut warnings: Vec<Warning> = analysis
         .not_identifiable
         .iter()
-        .map(|ni| ni.describe(&names, to_factor(theta0[ni.index])))
+        .map(|ni| Warning::NotIdentifiable {
+            parameter: ni.clone(),
+            names: names.clone(),
+            kept_at: to_factor(theta0[ni.index]),
+        })
         .collect();
     let fit = FitUncertainty::at(problem, &fitted.e_jac, &fitted.e, theta, free)?;
     warnings.extend(fit.uncertainty.warnings.iter().cloned());
@@ -272,7 +278,7 @@ pub fn identify(
         problem.statics(),
         &fit.static_estimates,
     );
-    warnings.extend(model_mismatch.as_ref().map(|m| m.warning()));
+    warnings.extend(model_mismatch.clone().map(Warning::ModelMismatch));
     let mut sims = problem.simulate_many(&[theta0.clone(), theta.clone()])?;
     let simulated_final = sims.pop().unwrap_or_default();
     let simulated_initial = sims.pop().unwrap_or_default();

@@ -76,6 +76,10 @@ impl Clone for Problem {
     }
 }
 
+/// The weighted error Jacobian, the weighted errors, and the parameters whose difference was
+/// one-sided ([`Problem::error_jacobian_edges`]).
+pub type JacobianEdges = (DMatrix<f64>, DVector<f64>, Vec<usize>);
+
 impl Problem {
     /// Checks that the model can run every test and builds the problem.
     pub fn new(
@@ -440,10 +444,7 @@ impl Problem {
     /// As [`Problem::error_jacobian_at`], with the parameters whose difference had to be
     /// one-sided because a neighbour of θ cannot be simulated: θ lies at the edge of what the
     /// model can run (e.g. the closed loop's stability limit).
-    pub fn error_jacobian_edges(
-        &self,
-        theta: &DVector<f64>,
-    ) -> Result<(DMatrix<f64>, DVector<f64>, Vec<usize>), IdentError> {
+    pub fn error_jacobian_edges(&self, theta: &DVector<f64>) -> Result<JacobianEdges, IdentError> {
         let h: Vec<f64> = theta
             .iter()
             .map(|t| self.settings.fd_step * t.abs())

@@ -467,7 +467,7 @@ impl IdentReport {
                 .into(),
             ),
             refusal: result.refusal.as_ref().map(|e| e.to_string()),
-            warnings: result.warnings.clone(),
+            warnings: result.warnings.iter().map(ToString::to_string).collect(),
             notes: result.notes.clone(),
             rejected_steps: Some(result.rejected_steps),
             not_identifiable: result

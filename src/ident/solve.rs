@@ -2,7 +2,7 @@
 //! progress observer) and confirming a harmonic optimisation in the time domain.
 
 use super::problem::Reduced;
-use super::{lm, settings, EijMap, IdentError, Method, Problem, ProgressFn, SolverKind};
+use super::{lm, settings, EijMap, IdentError, Method, Problem, ProgressFn, SolverKind, Warning};
 use argmin::core::observers::{Observe, ObserverMode};
 use argmin::core::{Executor, State, TerminationReason, KV};
 use nalgebra::DVector;
@@ -121,11 +121,11 @@ pub(super) fn confirm_in_time_domain(
     problem: &Problem,
     theta: &DVector<f64>,
     harmonic: &[EijMap],
-) -> Result<(Vec<EijMap>, Option<String>), IdentError> {
+) -> Result<(Vec<EijMap>, Option<Warning>), IdentError> {
     let time = problem
         .simulate_many_with(std::slice::from_ref(theta), SolverKind::Time)?
         .remove(0);
-    let mut worst = (0.0, String::new());
+    let mut worst: (f64, Option<Warning>) = (0.0, None);
     for (i, (h, t)) in harmonic.iter().zip(&time).enumerate() {
         for (e, v) in h {
             let d = (v - t[e]).abs();
@@ -134,20 +134,16 @@ pub(super) fn confirm_in_time_domain(
             if d / allowed > worst.0 {
                 worst = (
                     d / allowed,
-                    format!(
-                        "{} {e}: harmonic {v:.4}, time domain {:.4}",
-                        problem.tests()[i].label(),
-                        t[e]
-                    ),
+                    Some(Warning::TimeDomainDisagrees {
+                        test: problem.tests()[i].label(),
+                        eij: *e,
+                        harmonic: *v,
+                        time: t[e],
+                    }),
                 );
             }
         }
     }
-    let warning = (worst.0 > 1.0).then(|| {
-        format!(
-            "harmonic and time-domain EIJ disagree beyond 1 % / 0.01 µm·s²/m: {}",
-            worst.1
-        )
-    });
+    let warning = if worst.0 > 1.0 { worst.1 } else { None };
     Ok((time, warning))
 }

@@ -10,7 +10,7 @@
 
 use super::parameters::to_factor;
 use super::settings::{NEAR_SINGULAR, WEAK_REL_STD_ERR};
-use super::IdentError;
+use super::{IdentError, Warning};
 use nalgebra::DMatrix;
 
 /// The uncertainty of the free parameters at the solution.
@@ -29,7 +29,7 @@ pub struct Uncertainty {
     /// Whether the χ² test failed (s ≫ 1).
     pub chi2_failed: bool,
     /// Warnings, in the order near-singular, χ², weakly determined parameters.
-    pub warnings: Vec<String>,
+    pub warnings: Vec<Warning>,
 }
 
 impl Uncertainty {
@@ -57,18 +57,18 @@ impl Uncertainty {
         let mut warnings = Vec::new();
         if let Some(last) = singular_values.last() {
             if *last < NEAR_SINGULAR * largest {
-                warnings.push(format!(
-                    "the tests hardly separate some parameter combination (singular values {largest:.3e} … {last:.3e}): correlated estimates"
-                ));
+                warnings.push(Warning::NearSingular {
+                    largest,
+                    smallest: *last,
+                });
             }
         }
         // χ² test of the fit: with honest σ, s² = χ²/(m − n) scatters about 1 by √(2/(m − n)).
         let chi2_failed = !super::verdict::Chi2::new(s2.sqrt(), dof as usize).passed;
         if chi2_failed {
-            warnings.push(format!(
-                "χ² test failed: residual std s = {:.2} ≫ 1, the model cannot reproduce the measured EIJ within their uncertainty (a missing parameter, a model error, or σ too small). The standard errors (scaled by s) do not cover such a model error: the identified factors may be off by more than they say",
-                s2.sqrt()
-            ));
+            warnings.push(Warning::Chi2Failed {
+                residual_std: s2.sqrt(),
+            });
         }
         // cov = s² V Σ⁻² Vᵀ over the directions above the rank threshold.
         let threshold = largest * f64::EPSILON * m.max(n) as f64;
@@ -93,10 +93,11 @@ impl Uncertainty {
         for k in 0..n {
             let value = to_factor(theta[k]);
             if std_err[k] > WEAK_REL_STD_ERR * value {
-                warnings.push(format!(
-                    "{} = {:.3} ± {:.3} is only weakly determined by these tests (correlated with others, see the correlation matrix)",
-                    names[k], value, std_err[k]
-                ));
+                warnings.push(Warning::WeaklyDetermined {
+                    name: names[k].to_string(),
+                    value,
+                    std_err: std_err[k],
+                });
             }
         }
         Ok(Uncertainty {

@@ -71,6 +71,8 @@ pub fn grid(positions_mm: &[[f64; 3]], planes: &[Plane], accels: &[f64]) -> Vec<
 }
 
 /// The series of one planned test on `truth` with `imp`, r = 2 mm.
+// The sample index runs over the internal and external series of three axes at once.
+#[allow(clippy::needless_range_loop)]
 pub fn series(truth: &Machine, t: &Planned, imp: &Imperfections, seed: u64) -> CircleSeries {
     let radius_m = 2e-3;
     let pose: Vec<f64> = t.position_mm.iter().map(|v| v * 1e-3).collect();
