@@ -210,6 +210,8 @@ fn merged(x: &Errors, y: &Errors) -> Errors {
         tilt_um_per_m: add2(x.tilt_um_per_m, y.tilt_um_per_m),
         saddle_um: add2(x.saddle_um, y.saddle_um),
         normal_play_um: add2(x.normal_play_um, y.normal_play_um),
+        rotation_um_per_m: x.rotation_um_per_m + y.rotation_um_per_m,
+        clock_rate_um_per_m: x.clock_rate_um_per_m + y.clock_rate_um_per_m,
     }
 }
 

@@ -21,6 +21,10 @@ pub(crate) const ID: &str = "certificate";
 /// The last line of the certificate (the print check looks for it on the certificate's page).
 pub(crate) const END: &str = "End of certificate.";
 
+/// About as many tests as fit on the one A4 page of the printed certificate (a test is one
+/// table line of about 3.3 mm; measured with `tests/print-check.sh`, docs/diagnosis.md).
+const ONE_PAGE_TESTS: usize = 75;
+
 /// What the certificate states besides the tests.
 pub(crate) struct CertificateInput<'a> {
     /// The evaluated tests.
@@ -226,6 +230,14 @@ pub(crate) fn certificate(page: &mut Page, c: &CertificateInput) {
         );
     }
     h.push_str("</table>\n");
+    if tests.len() > ONE_PAGE_TESTS {
+        let _ = writeln!(
+            h,
+            "<p class=\"note\"><b>{} tests: printed, this certificate runs onto a second A4 page \
+             (one page holds about {ONE_PAGE_TESTS} tests); keep the pages together.</b></p>",
+            tests.len()
+        );
+    }
     let _ = writeln!(
         h,
         "<p class=\"note\">G: ISO 230-4 circular deviation over the steady revolutions, of the \

@@ -10,6 +10,9 @@
 //!   a spike h·e^{−Δt/τ} outward after each reversal of an axis (Δt since its velocity last
 //!   passed zero, from its phase), lateral play (λ/2)·sgn(v_a) across axis a, cyclic error A cos(2π a/P + φ) along
 //!   each axis, the out-of-plane offset, tilt t·(a, b), saddle and play (s/2)·sgn(v);
+//! * a rotation ρ of the path about the normal, ρ·(−b, a); a clock of the external readings
+//!   running ε faster than the internal ones, which read the path at t + ε·(t − t_mid):
+//!   ε·(t − t_mid)·v, t_mid the middle of the recording (meant for the structure);
 //! * structure: the same errors added to external − internal, plus EIJ d = E·ä with ä the
 //!   internal path's acceleration −ω²(a, b);
 //! * Gaussian noise on the internal and the external readings (ChaCha8, seeded).
@@ -58,6 +61,10 @@ pub struct Errors {
     pub saddle_um: [f64; 2],
     /// Out-of-plane step when each in-plane axis reverses, µm.
     pub normal_play_um: [f64; 2],
+    /// Rotation of the path about the normal, µm/m (µrad).
+    pub rotation_um_per_m: f64,
+    /// Rate of the clock against the internal one's, µm/m (ppm), about the recording's middle.
+    pub clock_rate_um_per_m: f64,
 }
 
 /// One synthetic circle test.
@@ -127,14 +134,16 @@ impl TermCircle {
                 );
                 let since = [pa, pb - 0.5 * PI].map(|p| (w.signum() * p).rem_euclid(PI) / w.abs());
                 Point {
+                    t: ti,
                     p: [r * pa.cos(), r * pb.sin()],
                     v: [-r * w * pa.sin(), r * w * pb.cos()],
                     since,
                 }
             })
             .collect();
-        let int_dev = deviations(&self.internal, &path, r, w);
-        let str_dev = deviations(&self.structure, &path, r, w);
+        let t_mid = 0.5 * t.last().copied().unwrap_or(0.0);
+        let int_dev = deviations(&self.internal, &path, r, w, t_mid);
+        let str_dev = deviations(&self.structure, &path, r, w, t_mid);
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(self.seed);
         let noise = |sigma: f64| Normal::new(0.0, sigma.max(1e-15)).unwrap();
         let (n_int, n_ext) = (noise(self.int_noise_um), noise(self.ext_noise_um));
@@ -181,6 +190,8 @@ fn sgn(x: f64) -> f64 {
 
 /// A point of the internal path.
 struct Point {
+    /// Time, s.
+    t: f64,
     /// Position (a, b), mm.
     p: [f64; 2],
     /// Velocity, mm/s.
@@ -189,10 +200,10 @@ struct Point {
     since: [f64; 2],
 }
 
-/// The deviation (a, b, k), µm, of `e` along the path.
-fn deviations(e: &Errors, path: &[Point], r: f64, w: f64) -> Vec<[f64; 3]> {
+/// The deviation (a, b, k), µm, of `e` along the path (`t_mid`: the clock's reference time).
+fn deviations(e: &Errors, path: &[Point], r: f64, w: f64, t_mid: f64) -> Vec<[f64; 3]> {
     let mut out = Vec::with_capacity(path.len());
-    for Point { p, v, since } in path {
+    for Point { t, p, v, since } in path {
         let (pa, pb) = (p[0] / r, p[1] / r);
         let mut d = [
             e.centre_um[0] + e.radius_um * pa + 0.5 * e.scale_mismatch_um * pa,
@@ -200,6 +211,12 @@ fn deviations(e: &Errors, path: &[Point], r: f64, w: f64) -> Vec<[f64; 3]> {
             e.normal_offset_um,
         ];
         d[0] += e.squareness_um_per_m * p[1] * 1e-3;
+        // Rotation ρ µrad of a point p mm: ρ·(−b, a)·10⁻³ µm; the clock: ε·10⁻⁶·(t − t_mid)·v mm.
+        d[0] -= e.rotation_um_per_m * p[1] * 1e-3;
+        d[1] += e.rotation_um_per_m * p[0] * 1e-3;
+        for (ax, d_ax) in d.iter_mut().take(2).enumerate() {
+            *d_ax += e.clock_rate_um_per_m * (t - t_mid) * v[ax] * 1e-3;
+        }
         d[1] += e.straightness_um[0] * (pa * pa - 0.5);
         d[0] += e.straightness_um[1] * (pb * pb - 0.5);
         for ax in 0..2 {
