@@ -409,3 +409,70 @@ fn support_is_checked_once_per_pose_and_never_waved_through() {
         assert_eq!(near.a, full.a, "factor {f}");
     }
 }
+
+/// A centre stops making Lyapunov certificates once one proved no loop but its own (the
+/// elastic column's lightly damped modes: every finite-difference step needs a new one, which
+/// costs several eigenvalue checks), and keeps making them where they pay (the rigid demo's
+/// steps); the verdict of `new_near` is the eigenvalues' either way.
+#[test]
+fn certificates_that_prove_nothing_are_no_longer_made_and_the_verdict_stays() {
+    use eij::control::stability::MAX_WASTED_RENEWALS;
+    use eij::control::PoseChecks;
+    use eij::machine::Reduction;
+    use eij::mbs::Model;
+    let demo = load("demo-vmc.toml");
+    let pose = demo.reference_pose();
+    let with_factor = |f: f64| {
+        let mut m = demo.clone();
+        m.set_reduction(0, Reduction::GuidewayNormal, f).unwrap();
+        m
+    };
+    let a_of = |f: f64| {
+        let m = with_factor(f);
+        ClosedLoop::from_model(&m, Model::assemble(&m, &pose).unwrap()).a
+    };
+    // Where certificates pay: each proves the next 1e-3 step, and renewing goes on.
+    let paying = PoseChecks::default();
+    assert!(!paying.stability.renew(&a_of(1.0)), "the first visit");
+    for k in 0..4 {
+        let f = 1.0 + 0.2 * k as f64;
+        assert!(paying.stability.renew(&a_of(f)), "certificate at {f}");
+        assert!(paying.stability.certifies(&a_of(f * 1.001)));
+    }
+    assert!(!paying.stability.given_up());
+    // Where they do not: loops far apart, each certificate proves only its own.
+    let wasted = PoseChecks::default();
+    assert!(!wasted.stability.renew(&a_of(1.0)));
+    let mut made = 0;
+    for f in [0.3, 3.0, 0.05, 8.0] {
+        assert!(!wasted.stability.certifies(&a_of(f)), "far from the last");
+        if wasted.stability.renew(&a_of(f)) {
+            made += 1;
+        }
+    }
+    assert_eq!(made, MAX_WASTED_RENEWALS as usize);
+    assert!(wasted.stability.given_up());
+    // The verdict is the eigenvalues': stable loops pass, an unstable one is refused.
+    for f in [0.3, 1.0, 5.0] {
+        assert!(ClosedLoop::new_near(&with_factor(f), &pose, &wasted).is_ok());
+    }
+    let text = std::fs::read_to_string(common::root().join("machines/reference/single-axis.toml"))
+        .unwrap();
+    let unstable = Machine::from_toml_str(
+        &text.replace("kp_nm_s_per_rad = 2.0", "kp_nm_s_per_rad = 2000.0"),
+        "kp.toml",
+    )
+    .unwrap();
+    let at_0 = Pose::new(&unstable, &[0.0]).unwrap();
+    let near = PoseChecks::default();
+    let stable_text = Machine::from_toml_str(&text, "kp.toml").unwrap();
+    let a = |m: &Machine| ClosedLoop::from_model(m, Model::assemble(m, &at_0).unwrap()).a;
+    assert!(!near.stability.renew(&a(&stable_text)));
+    assert!(near.stability.renew(&a(&stable_text)));
+    assert!(ClosedLoop::new_near(&unstable, &at_0, &near).is_err());
+    assert!(
+        near.stability.given_up(),
+        "a certificate that proved nothing"
+    );
+    assert!(ClosedLoop::new_near(&unstable, &at_0, &near).is_err());
+}

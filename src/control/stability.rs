@@ -89,8 +89,20 @@ impl Certificate {
 /// changes its verdict, only what the check costs). The first loop at a centre is checked by
 /// its eigenvalues alone: a certificate costs about twice that and pays only where more loops
 /// follow (a Jacobian's, not a map's one loop per grid point).
+///
+/// A certificate pays only when it proves loops after the one it was made from. Where the
+/// loops have lightly damped modes (an elastic body's, ζ ≈ 1 % at kHz), P is large along them
+/// and a finite-difference step already breaks B′ᵀP + PB′ ≺ 0: each new certificate proves its
+/// own loop and no other, and renewing it costs several eigenvalue checks per loop. So after
+/// [`MAX_WASTED_RENEWALS`] certificates in a row that proved no further loop, this centre stops
+/// making them and the eigenvalues decide (the same verdict; only the cost changes).
 #[derive(Debug, Default)]
 pub struct NearbyCertificate(Mutex<Slot>);
+
+/// Certificates in a row that proved no loop but their own, after which a centre makes no more
+/// (one: a certificate that proved nothing says the next will not either, and costs several
+/// eigenvalue checks).
+pub const MAX_WASTED_RENEWALS: u32 = 1;
 
 /// What a [`NearbyCertificate`] holds.
 #[derive(Debug, Default)]
@@ -99,24 +111,54 @@ struct Slot {
     visited: bool,
     /// The latest certificate made here.
     certificate: Option<Arc<Certificate>>,
+    /// Loops the latest certificate proved besides its own.
+    proved: u32,
+    /// Certificates in a row that proved no loop besides their own.
+    wasted: u32,
+}
+
+impl Slot {
+    /// Whether certificates have stopped paying here.
+    fn given_up(&self) -> bool {
+        self.wasted >= MAX_WASTED_RENEWALS
+    }
 }
 
 impl NearbyCertificate {
     /// Whether the stored certificate proves `a` stable.
     pub fn certifies(&self, a: &DMatrix<f64>) -> bool {
-        let cert = self.0.lock().ok().and_then(|c| c.certificate.clone());
-        cert.is_some_and(|c| c.certifies(a))
+        let cert = self
+            .0
+            .lock()
+            .ok()
+            .filter(|s| !s.given_up())
+            .and_then(|c| c.certificate.clone());
+        let proved = cert.is_some_and(|c| c.certifies(a));
+        if proved {
+            if let Ok(mut slot) = self.0.lock() {
+                slot.proved += 1;
+                slot.wasted = 0;
+            }
+        }
+        proved
     }
 
     /// For a loop the stored certificate does not prove: on the first visit nothing (false);
     /// afterwards makes `a`'s own certificate and stores it, true when one can be made (it
-    /// proves `a` stable; else the eigenvalues must decide).
+    /// proves `a` stable; else the eigenvalues must decide). Nothing (false) either once
+    /// certificates stopped paying here (see the type's docs).
     pub fn renew(&self, a: &DMatrix<f64>) -> bool {
-        let first = self
-            .0
-            .lock()
-            .map(|mut s| !std::mem::replace(&mut s.visited, true));
-        if first.unwrap_or(true) {
+        let go = self.0.lock().map(|mut s| {
+            if !std::mem::replace(&mut s.visited, true) {
+                return false;
+            }
+            if s.certificate.is_some() && s.proved == 0 {
+                s.wasted += 1;
+            }
+            s.proved = 0;
+            !s.given_up()
+        });
+        if !go.unwrap_or(false) {
             return false;
         }
         let Some(c) = Certificate::new(a) else {
@@ -126,5 +168,10 @@ impl NearbyCertificate {
             slot.certificate = Some(Arc::new(c));
         }
         true
+    }
+
+    /// Whether this centre stopped making certificates (they proved no loop but their own).
+    pub fn given_up(&self) -> bool {
+        self.0.lock().is_ok_and(|s| s.given_up())
     }
 }
