@@ -1,7 +1,9 @@
 //! What was measured, read from files: R-Test circle-test series in their CSV dialects and
 //! column maps ([`layout`], [`series`]), a folder's test conditions (`rtest.toml`, [`conditions`])
 //! and the tests they make ([`inputs`]), two-system recordings ([`recording`]), EIJ tables
-//! ([`table`]) and the evaluation JSON ([`json`]), positioning moves ([`moves`]); and the
+//! ([`table`]) and the evaluation JSON ([`json`]), positioning moves ([`moves`]), folders of
+//! two-system recordings paired by pattern (`[[pairing]]`) and internal readings in absolute
+//! machine coordinates (`internal_coordinates`); and the
 //! evaluation of a command's measured tests as one suite ([`suite`]: clocks aligned, each test
 //! evaluated by [`crate::rtest`] at its conditions, cw/ccw pairs).
 //!
@@ -23,12 +25,15 @@
 //! ```
 
 pub mod conditions;
+pub(crate) mod coordinates;
+pub(crate) mod entries;
 pub(crate) mod error;
 pub mod history;
 pub mod inputs;
 pub mod json;
 pub(crate) mod layout;
 pub mod moves;
+pub(crate) mod pairing;
 pub(crate) mod recording;
 pub(crate) mod series;
 pub mod suite;
