@@ -9,6 +9,7 @@ pub mod diagnosis_demo;
 pub mod imperfect;
 pub mod mutation;
 pub mod random_machine;
+pub mod shop;
 pub mod synth;
 
 use eij::machine::Machine;
