@@ -338,7 +338,7 @@ fn table_and_pooled_output() {
     assert!(r.ok, "{}", r.stderr);
     let v: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
     assert_eq!(v["tests"].as_array().unwrap().len(), 2);
-    let pooled = &v["pooled"];
+    let pooled = &v["pooled"][0];
     assert_eq!(pooled["plane"], "xy");
     assert_eq!(pooled["eij_um_s2_per_m"].as_object().unwrap().len(), 6);
     assert_eq!(pooled["geometric_um_per_mm"].as_object().unwrap().len(), 6);

@@ -238,8 +238,8 @@ fn report_is_one_self_contained_page_with_the_verdict_first() {
     for needle in [
         "<nav class=\"toc\">",
         "machines/demo-vmc.toml",
-        "pos-a (3 files)",
-        "pos-b (2 files)",
+        "pos-a (3 tests)",
+        "pos-b (2 tests)",
     ] {
         assert!(html.contains(needle), "header lacks {needle}");
     }

@@ -117,6 +117,8 @@ fn eij_table_round_trips_and_is_strict() {
             parameter: Eij::new(Axis::X, Axis::Z),
             value: -1.55,
             std_err: None,
+            radius_mm: None,
+            position_mm: None,
         },
         EijRow {
             plane: Plane::Xy,
@@ -125,6 +127,8 @@ fn eij_table_round_trips_and_is_strict() {
             parameter: Eij::new(Axis::Z, Axis::Y),
             value: 0.1 + 0.2,
             std_err: Some(0.0123),
+            radius_mm: None,
+            position_mm: None,
         },
     ];
     let p = d.join("t.csv");

@@ -121,26 +121,16 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<()> {
     };
     drop(spinner);
     let pooled = if args.pooled {
-        let refs: Vec<&CircleSeries> = suite.tests.iter().map(|t| &t.series).collect();
-        let radius_mm = suite
-            .tests
-            .first()
-            .filter(|t| t.radius_source != suite::RadiusSource::InternalMean)
-            .map(|t| t.result.radius_mm);
-        let opts = EvalOptions {
-            plane: args.plane,
-            radius_mm,
-        };
-        Some(rtest::evaluate_pooled(&refs, &opts).map_err(|e| super::advice::evaluate(e.into()))?)
+        pooled_groups(&suite, args.plane)?
     } else {
-        None
+        Vec::new()
     };
     let plot_svg = match (&args.plot, suite.tests.first()) {
         (Some(_), Some(t)) => {
             let cond = eij::report::Conditions {
                 source: t.input.name(),
                 machine: None,
-                position_mm: t.input.position_mm.clone(),
+                position_mm: t.input.test.position_mm.clone(),
             };
             let opts = EvalOptions {
                 plane: Some(t.result.plane),
@@ -151,11 +141,7 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<()> {
         _ => None,
     };
     let csv = args.csv_out.as_ref().map(|_| {
-        let rows: Vec<_> = suite
-            .tests
-            .iter()
-            .flat_map(|t| table::rows_from_result(&t.result))
-            .collect();
+        let rows: Vec<_> = suite.tests.iter().flat_map(table::rows_of_test).collect();
         table::to_csv(&rows)
     });
     let mut files: Vec<(&Path, &[u8])> = Vec::new();
@@ -194,8 +180,18 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<()> {
     }
     if args.json {
         let mut doc = suite.to_json_map();
-        if let Some(p) = &pooled {
-            doc.insert("pooled".into(), p.to_json());
+        if args.pooled {
+            let groups: Vec<serde_json::Value> = pooled
+                .iter()
+                .map(|(centre, p)| {
+                    let mut v = p.to_json();
+                    if let (Some(o), Some(c)) = (v.as_object_mut(), centre) {
+                        o.insert("position_mm".into(), serde_json::json!(c));
+                    }
+                    v
+                })
+                .collect();
+            doc.insert("pooled".into(), groups.into());
         }
         if let Some(d) = &diagnosis {
             d.add_to_json(&mut doc);
@@ -213,8 +209,8 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<()> {
         if let Some(d) = &diagnosis {
             super::evaluate_diagnosis::render_groups(&mut text, d);
         }
-        if let Some(p) = &pooled {
-            render_pooled(&mut text, p);
+        for (centre, p) in &pooled {
+            render_pooled(&mut text, p, centre.as_deref());
         }
         out!("{text}");
     }
@@ -331,12 +327,61 @@ pub(super) fn accelerations(a: &[f64]) -> String {
         .join(", ")
 }
 
-fn render_pooled(out: &mut String, p: &PooledResult) {
+/// `--pooled`: one pooled fit per plane and circle centre (tests at one centre and plane share
+/// their EIJ and static geometry). A group that cannot be pooled (one test, one acceleration)
+/// is an error when it is the only one, else a warning naming it.
+fn pooled_groups(
+    suite: &Suite,
+    plane: Option<Plane>,
+) -> anyhow::Result<Vec<(Option<Vec<f64>>, PooledResult)>> {
+    type Group<'a> = (Plane, Option<Vec<f64>>, Vec<&'a EvaluatedTest>);
+    let mut groups: Vec<Group> = Vec::new();
+    for t in &suite.tests {
+        let key = (t.result.plane, t.input.test.position_mm.clone());
+        match groups.iter_mut().find(|g| g.0 == key.0 && g.1 == key.1) {
+            Some(g) => g.2.push(t),
+            None => groups.push((key.0, key.1, vec![t])),
+        }
+    }
+    let several = groups.len() > 1;
+    let mut out = Vec::new();
+    for (p, centre, tests) in groups {
+        let refs: Vec<&CircleSeries> = tests.iter().map(|t| &t.series).collect();
+        let radius_mm = tests
+            .first()
+            .filter(|t| t.radius_source != suite::RadiusSource::InternalMean)
+            .map(|t| t.result.radius_mm);
+        let opts = EvalOptions {
+            plane: plane.or(Some(p)),
+            radius_mm,
+        };
+        match rtest::evaluate_pooled(&refs, &opts) {
+            Ok(r) => out.push((centre, r)),
+            Err(e) if several => errln!(
+                "eij: warning: pooled plane {p}{}: {e}",
+                centre
+                    .as_deref()
+                    .map_or(String::new(), |c| format!(" at {} mm", eij::text::nums(c)))
+            ),
+            Err(e) => return Err(super::advice::evaluate(e.into())),
+        }
+    }
+    if out.is_empty() {
+        anyhow::bail!("--pooled: no plane holds tests that can be pooled (see the warnings)");
+    }
+    Ok(out)
+}
+
+fn render_pooled(out: &mut String, p: &PooledResult, centre: Option<&[f64]>) {
     let _ = writeln!(
         out,
-        "pooled over {} tests, plane {}, accelerations {} m/s²",
+        "pooled over {} tests, plane {}{}, accelerations {} m/s²",
         p.sources.len(),
         p.plane,
+        centre.map_or(String::new(), |c| format!(
+            ", circle centre {} mm",
+            eij::text::nums(c)
+        )),
         accelerations(&p.accel_m_s2)
     );
     let _ = writeln!(

@@ -305,7 +305,9 @@ fn print_statics(result: &IdentResult, tables: bool) {
     }
 }
 
-/// The clock offsets fitted with the EIJ: the largest, with `tables` all.
+/// The clock offsets fitted with the EIJ: the largest, with `tables` all. Printed in the sign
+/// of every clock offset eij prints: internal clock minus external clock (the negative of the
+/// report's `external_late_ms`).
 fn print_fitted_clocks(result: &IdentResult, tables: bool) {
     let fitted = eij::ident::diagnosis::fitted_clocks(result);
     let Some(largest) = fitted.iter().max_by(|a, b| {
@@ -316,9 +318,9 @@ fn print_fitted_clocks(result: &IdentResult, tables: bool) {
         return;
     };
     outln!(
-        "  clock offsets fitted with the EIJ (external readings late): {}, largest {:+.4} ± {:.4} ms ({})",
+        "  clock offsets fitted with the EIJ (internal minus external clock, negative: external readings late): {}, largest {:+.4} ± {:.4} ms ({})",
         fitted.len(),
-        largest.external_late_ms,
+        -largest.external_late_ms,
         largest.std_err_ms,
         largest.clock
     );
@@ -327,7 +329,7 @@ fn print_fitted_clocks(result: &IdentResult, tables: bool) {
             outln!(
                 "  {:<40} {:+.4} ± {:.4} ms",
                 c.clock,
-                c.external_late_ms,
+                -c.external_late_ms,
                 c.std_err_ms
             );
         }
@@ -426,7 +428,7 @@ pub(super) fn print_clocks(clocks: &[eij::measured::suite::ClockReport], tables:
     }
     let applied = clocks.iter().filter(|c| c.applied).count();
     outln!(
-        "  clock offsets estimated by the evaluation (internal minus external clock): {}, {applied} applied",
+        "  clock offsets estimated by the evaluation (internal minus external clock, negative: external readings late): {}, {applied} applied",
         clocks.len()
     );
     if !tables {

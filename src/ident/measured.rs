@@ -45,7 +45,7 @@ pub fn load_measured(
     let inputs = &inputs.tests;
     let (tables, series): (Vec<&TestInput>, Vec<&TestInput>) = inputs
         .iter()
-        .partition(|t| matches!(&t.data, DataFiles::Single(f) if table::looks_like_table(f)));
+        .partition(|t| matches!(&t.test.data, DataFiles::Single(f) if table::looks_like_table(f)));
     let series: Vec<TestInput> = series.into_iter().cloned().collect();
     let suite = evaluate_tests(
         &series,
@@ -81,11 +81,12 @@ pub fn load_measured(
     let mut tests = Vec::new();
     for input in inputs {
         let position_m = input
+            .test
             .position_mm
             .as_ref()
             .map(|p| p.iter().map(|v| v * 1e-3).collect::<Vec<f64>>());
         if tables.iter().any(|t| std::ptr::eq(*t, input)) {
-            let radius_mm = input.radius_mm.unwrap_or(opts.radius_mm);
+            let radius_mm = input.test.radius_mm.unwrap_or(opts.radius_mm);
             tests.extend(table_tests(input, radius_mm, position_m, opts)?);
             continue;
         }
@@ -110,7 +111,7 @@ pub fn load_measured(
             ),
         });
     }
-    if let Some((input, message)) = table_of_series(&tests) {
+    if let Some((input, message)) = table_of_series(&tests).or_else(|| unplaced_table(&tests)) {
         return Err(IdentError::Test { input, message });
     }
     Ok(Measured {
@@ -154,7 +155,8 @@ fn table_of_series(tests: &[TestCase]) -> Option<(String, String)> {
     None
 }
 
-/// The tests of an EIJ table, one per plane, direction and acceleration.
+/// The tests of an EIJ table, one per plane, direction, acceleration, radius and circle
+/// centre; a row's own radius and centre (`radius_mm`, `position_*_mm`) over the folder's.
 fn table_tests(
     input: &TestInput,
     radius_mm: f64,
@@ -163,24 +165,36 @@ fn table_tests(
 ) -> Result<Vec<TestCase>, IdentError> {
     let name = input.name();
     let rows = table::read(input.primary_file())?;
-    let mut groups: BTreeMap<(String, String, u64), TestCase> = BTreeMap::new();
+    type Key = (String, String, u64, Option<u64>, Option<[u64; 3]>);
+    let mut groups: BTreeMap<Key, TestCase> = BTreeMap::new();
     for row in rows {
         let key = (
             row.plane.to_string(),
             row.direction.to_string(),
             row.accel_m_s2.to_bits(),
+            row.radius_mm.map(f64::to_bits),
+            row.position_mm.map(|p| p.map(f64::to_bits)),
         );
         let case = groups.entry(key).or_insert_with(|| TestCase {
             source: format!(
-                "{name} ({} {} {} m/s²)",
-                row.plane, row.direction, row.accel_m_s2
+                "{name} ({} {} {} m/s²{})",
+                row.plane,
+                row.direction,
+                row.accel_m_s2,
+                row.position_mm.map_or(String::new(), |p| format!(
+                    " at {} mm",
+                    crate::text::nums(&p)
+                ))
             ),
             circle: CircleTest {
                 plane: row.plane,
                 direction: row.direction,
-                radius_mm,
+                radius_mm: row.radius_mm.unwrap_or(radius_mm),
                 accel_m_s2: row.accel_m_s2,
-                position_m: position_m.clone(),
+                position_m: row
+                    .position_mm
+                    .map(|p| p.iter().map(|v| v * 1e-3).collect())
+                    .or_else(|| position_m.clone()),
             },
             measured: EijEstimates::new(),
             clock: None,
@@ -189,4 +203,42 @@ fn table_tests(
         case.measured.insert(row.parameter, row.value, std_err);
     }
     Ok(groups.into_values().collect())
+}
+
+/// A table test without a circle centre among tests at several centres: identify cannot tell
+/// where it was run (it would take the machine's reference position, and its EIJ would be
+/// fitted there). Returns the table's test and what is wrong, for the error that refuses it.
+fn unplaced_table(tests: &[TestCase]) -> Option<(String, String)> {
+    let mut centres: Vec<&Vec<f64>> = Vec::new();
+    for t in tests {
+        if let Some(p) = &t.circle.position_m {
+            if !centres.contains(&p) {
+                centres.push(p);
+            }
+        }
+    }
+    if centres.len() < 2 {
+        return None;
+    }
+    let t = tests
+        .iter()
+        .find(|t| t.clock.is_none() && t.circle.position_m.is_none())?;
+    let list: Vec<String> = centres
+        .iter()
+        .map(|p| {
+            let mm: Vec<f64> = p.iter().map(|v| v * 1e3).collect();
+            crate::text::nums(&mm)
+        })
+        .collect();
+    Some((
+        t.source.clone(),
+        format!(
+            "the table gives no circle centre (columns position_x_mm, position_y_mm, \
+             position_z_mm, or position_mm in its folder's rtest.toml) while the other \
+             measured tests lie at {} centres ({} mm): its tests cannot be placed; write the table \
+             with eij evaluate --csv-out (which adds the centres) or state position_mm",
+            centres.len(),
+            list.join(", ")
+        ),
+    ))
 }

@@ -2,12 +2,17 @@
 //! folder in `rtest.toml` (docs/measurement-files.md): the set radius and circle-centre
 //! position, how the files name their columns and in which unit (`[columns]`), and per-test
 //! entries (`[[test]]`) with their own conditions, including tests recorded by two systems
-//! (an `internal` and an `external` file with their own clocks); the tolerances the tests are
-//! judged against (`[tolerances]`) and the settings of their diagnosis (`[diagnosis]`).
+//! (an `internal` and an `external` file with their own clocks), folders of such recordings
+//! paired by file name or recording order (`[[pairing]]`), internal readings in absolute
+//! machine coordinates (`internal_coordinates`); the tolerances the tests are judged against
+//! (`[tolerances]`) and the settings of their diagnosis (`[diagnosis]`).
 
+use super::entries::{
+    check_position, check_radius, pairing_entry, test_entry, RawPairing, RawTest,
+};
+pub use super::entries::{Coordinates, DataFiles, Pairing, TestEntry};
 use super::error::MeasuredError;
 use super::layout::{ColumnEntry, ColumnMap};
-use crate::axes::{Direction, Plane};
 use crate::rtest::diagnosis::tolerance::Tolerances;
 use crate::rtest::diagnosis::DiagnosisOptions;
 use serde::Deserialize;
@@ -34,8 +39,13 @@ pub struct TestConditions {
     pub internal_columns: ColumnMap,
     /// `[columns]` with `[external_columns]` over it: the map of their external files.
     pub external_columns: ColumnMap,
+    /// How the internal readings are given (`internal_coordinates`; absent: relative to the
+    /// circle centre).
+    pub internal_coordinates: Option<Coordinates>,
     /// The `[[test]]` entries, in file order.
     pub tests: Vec<TestEntry>,
+    /// The `[[pairing]]` entries, in file order.
+    pub pairings: Vec<Pairing>,
     /// Limits on G and on the diagnosis' terms (`[tolerances]`, docs/diagnosis.md).
     pub tolerances: Tolerances,
     /// Settings of the diagnosis (`[diagnosis]`).
@@ -147,49 +157,6 @@ pub(crate) fn epoch_s(date: &str) -> Result<f64, String> {
         .map_err(|_| format!("{date}: before 1970"))
 }
 
-/// What a test's data are: one file with both measurements, or one file per measuring system
-/// (each read into one system's [`crate::rtest::clock::Recording`]).
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum DataFiles {
-    /// One file with `t_s`, the internal and the external columns.
-    Single(PathBuf),
-    /// Two systems with their own clocks: the internal file (`t_s` and `_int_mm`, e.g. a CNC
-    /// trace) and the external one (`t_s` and `_ext_mm`, e.g. the R-Test logger).
-    Split {
-        /// The internal (axis readings) file.
-        internal: PathBuf,
-        /// The external (R-Test) file.
-        external: PathBuf,
-    },
-}
-
-/// One `[[test]]` entry: its data and the conditions that override the folder's.
-#[derive(Debug, Clone, PartialEq)]
-pub struct TestEntry {
-    /// 1-based number of the entry in `rtest.toml`.
-    pub number: usize,
-    /// Its data, paths relative to the folder resolved.
-    pub data: DataFiles,
-    /// Circle plane, where stated.
-    pub plane: Option<Plane>,
-    /// Sense of rotation, where stated (checked against the data).
-    pub direction: Option<Direction>,
-    /// Set radius, mm.
-    pub radius_mm: Option<f64>,
-    /// Circle-centre position, mm.
-    pub position_mm: Option<Vec<f64>>,
-    /// Programmed feed, mm/min (checked against the data).
-    pub feed_mm_min: Option<f64>,
-    /// Free text carried into the outputs.
-    pub note: Option<String>,
-    /// The clock group: tests of one group share one constant clock offset (default: one
-    /// group per folder; single-file and two-system tests are grouped apart).
-    pub clock: Option<String>,
-    /// A known clock offset (internal clock minus external clock), ms: used as given, not
-    /// estimated (for a single file: the lag of its external columns, negative when they lag).
-    pub time_offset_ms: Option<f64>,
-}
-
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawConditions {
@@ -198,30 +165,17 @@ struct RawConditions {
     columns: Option<BTreeMap<String, ColumnEntry>>,
     internal_columns: Option<BTreeMap<String, ColumnEntry>>,
     external_columns: Option<BTreeMap<String, ColumnEntry>>,
+    internal_coordinates: Option<String>,
     #[serde(default)]
     test: Vec<RawTest>,
+    #[serde(default)]
+    pairing: Vec<RawPairing>,
     tolerances: Option<toml::Table>,
     diagnosis: Option<DiagnosisSettings>,
     machine: Option<String>,
     date: Option<toml::Value>,
     instrument: Option<String>,
     temperature_c: Option<f64>,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawTest {
-    file: Option<PathBuf>,
-    internal: Option<PathBuf>,
-    external: Option<PathBuf>,
-    plane: Option<String>,
-    direction: Option<String>,
-    radius_mm: Option<f64>,
-    position_mm: Option<Vec<f64>>,
-    feed_mm_min: Option<f64>,
-    note: Option<String>,
-    clock: Option<String>,
-    time_offset_ms: Option<f64>,
 }
 
 impl TestConditions {
@@ -293,15 +247,27 @@ impl TestConditions {
             columns.overridden_by(&map(&raw.internal_columns, "internal_columns")?);
         let external_columns =
             columns.overridden_by(&map(&raw.external_columns, "external_columns")?);
-        if raw.test.len() > MAX_TESTS {
-            return Err(bad(
-                "[[test]]",
-                format!("{} entries, at most {}", raw.test.len(), MAX_TESTS),
-            ));
+        for (table, n) in [
+            ("[[test]]", raw.test.len()),
+            ("[[pairing]]", raw.pairing.len()),
+        ] {
+            if n > MAX_TESTS {
+                return Err(bad(table, format!("{n} entries, at most {MAX_TESTS}")));
+            }
         }
+        let internal_coordinates = raw
+            .internal_coordinates
+            .as_deref()
+            .map(str::parse::<Coordinates>)
+            .transpose()
+            .map_err(|m| bad("internal_coordinates", m))?;
         let mut tests = Vec::new();
         for (i, t) in raw.test.into_iter().enumerate() {
             tests.push(test_entry(i + 1, t, &bad)?);
+        }
+        let mut pairings = Vec::new();
+        for (i, p) in raw.pairing.into_iter().enumerate() {
+            pairings.push(pairing_entry(i + 1, p, &bad)?);
         }
         let tolerances = match &raw.tolerances {
             Some(t) => Tolerances::from_toml(t).map_err(|e| bad(&e.key, e.message))?,
@@ -317,7 +283,9 @@ impl TestConditions {
             columns,
             internal_columns,
             external_columns,
+            internal_coordinates,
             tests,
+            pairings,
             tolerances,
             diagnosis,
             session,
@@ -365,125 +333,6 @@ fn session(
         date,
         instrument: text(&raw.instrument),
         temperature_c: raw.temperature_c,
-    })
-}
-
-fn check_radius(
-    r: Option<f64>,
-    key: &str,
-    bad: &dyn Fn(&str, String) -> MeasuredError,
-) -> Result<(), MeasuredError> {
-    match r {
-        Some(r) if !(r.is_finite() && r > 0.0 && r <= 3.0) => Err(bad(
-            key,
-            format!("{} must lie in (0, 3] mm", crate::text::num(r)),
-        )),
-        _ => Ok(()),
-    }
-}
-
-fn check_position(
-    p: Option<&[f64]>,
-    key: &str,
-    bad: &dyn Fn(&str, String) -> MeasuredError,
-) -> Result<(), MeasuredError> {
-    match p {
-        Some(p) if p.iter().any(|v| !v.is_finite()) => {
-            Err(bad(key, "values must be finite".into()))
-        }
-        Some([]) => Err(bad(key, "empty; give one position per machine axis".into())),
-        Some(p) if p.len() > 3 || p.iter().any(|v| v.abs() > 1e5) => Err(bad(
-            key,
-            format!(
-                "{} mm: give one position per machine axis (at most 3, within ±1e5 mm)",
-                crate::text::nums(p)
-            ),
-        )),
-        _ => Ok(()),
-    }
-}
-
-fn test_entry(
-    number: usize,
-    t: RawTest,
-    bad: &dyn Fn(&str, String) -> MeasuredError,
-) -> Result<TestEntry, MeasuredError> {
-    let key = |k: &str| format!("[[test]] #{number} {k}");
-    let data = match (t.file, t.internal, t.external) {
-        (Some(f), None, None) => DataFiles::Single(f),
-        (None, Some(internal), Some(external)) => {
-            if internal == external {
-                return Err(bad(
-                    &key("external"),
-                    "names the same file as internal".into(),
-                ));
-            }
-            DataFiles::Split { internal, external }
-        }
-        (None, Some(_), None) => {
-            return Err(bad(
-                &key("external"),
-                "missing: internal needs its external file".into(),
-            ))
-        }
-        (None, None, Some(_)) => {
-            return Err(bad(
-                &key("internal"),
-                "missing: external needs its internal file".into(),
-            ))
-        }
-        (None, None, None) => {
-            return Err(bad(
-                &key("file"),
-                "missing: give file, or internal and external".into(),
-            ))
-        }
-        (Some(_), _, _) => {
-            return Err(bad(
-                &key("file"),
-                "give either file or internal and external, not both".into(),
-            ))
-        }
-    };
-    let plane = t
-        .plane
-        .map(|p| p.parse::<Plane>())
-        .transpose()
-        .map_err(|m| bad(&key("plane"), m))?;
-    let direction = t
-        .direction
-        .map(|d| d.parse::<Direction>())
-        .transpose()
-        .map_err(|m| bad(&key("direction"), m))?;
-    check_radius(t.radius_mm, &key("radius_mm"), bad)?;
-    check_position(t.position_mm.as_deref(), &key("position_mm"), bad)?;
-    if let Some(f) = t.feed_mm_min {
-        if !(f.is_finite() && f > 0.0) {
-            return Err(bad(
-                &key("feed_mm_min"),
-                format!("{} must be a positive feed", crate::text::num(f)),
-            ));
-        }
-    }
-    if let Some(o) = t.time_offset_ms {
-        if !(o.is_finite() && o.abs() <= 3.6e6) {
-            return Err(bad(
-                &key("time_offset_ms"),
-                format!("{} must be finite, within an hour", crate::text::num(o)),
-            ));
-        }
-    }
-    Ok(TestEntry {
-        number,
-        data,
-        plane,
-        direction,
-        radius_mm: t.radius_mm,
-        position_mm: t.position_mm,
-        feed_mm_min: t.feed_mm_min,
-        note: t.note,
-        clock: t.clock,
-        time_offset_ms: t.time_offset_ms,
     })
 }
 

@@ -110,6 +110,15 @@ pub enum MeasuredError {
         /// What is wrong.
         message: String,
     },
+    /// The two recordings of a two-system test are not of one circle (plane, direction or
+    /// frequency differ): files paired wrongly.
+    #[error("{test}: not one test: {message}")]
+    NotOnePair {
+        /// The test (`internal + external`).
+        test: String,
+        /// What differs, and how the files were paired.
+        message: String,
+    },
     /// A cell with a value outside its domain (EIJ tables: plane, direction, parameter, ...).
     #[error("{at}: column {column}: {message}")]
     BadValue {

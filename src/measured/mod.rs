@@ -2,7 +2,9 @@
 //! column maps ([`layout`], [`series`]), a folder's test conditions (`rtest.toml`, [`conditions`])
 //! and the tests they make ([`inputs`]), two-system recordings ([`recording`]), EIJ tables
 //! ([`table`]) and the evaluation JSON ([`json`]), positioning moves ([`moves`]), controller traces
-//! as internal recordings (TNCscope, Sinumerik: [`traces`]); and the
+//! as internal recordings (TNCscope, Sinumerik: [`traces`]), folders of two-system recordings
+//! paired by pattern (`[[pairing]]`) and internal readings in absolute machine coordinates
+//! (`internal_coordinates`); and the
 //! evaluation of a command's measured tests as one suite ([`suite`]: clocks aligned, each test
 //! evaluated by [`crate::rtest`] at its conditions, cw/ccw pairs).
 //!
@@ -24,12 +26,15 @@
 //! ```
 
 pub mod conditions;
+pub(crate) mod coordinates;
+pub(crate) mod entries;
 pub(crate) mod error;
 pub mod history;
 pub mod inputs;
 pub mod json;
 pub(crate) mod layout;
 pub mod moves;
+pub(crate) mod pairing;
 pub(crate) mod recording;
 pub(crate) mod series;
 pub mod suite;

@@ -44,12 +44,24 @@ impl CircleSeries {
         bytes: &[u8],
         map: &ColumnMap,
     ) -> Result<Self, MeasuredError> {
+        Self::from_csv_placed(name, bytes, map, |_| Ok(()))
+    }
+
+    /// As [`CircleSeries::from_csv_bytes_with`], the internal columns (x, y, z, mm) handed to
+    /// `place` before the series is built (absolute coordinates made relative, or refused).
+    pub(crate) fn from_csv_placed(
+        name: &str,
+        bytes: &[u8],
+        map: &ColumnMap,
+        place: impl FnOnce(&mut [Vec<f64>; 3]) -> Result<(), MeasuredError>,
+    ) -> Result<Self, MeasuredError> {
         let table = read_table(name, bytes, &CONTRACT_COLUMNS, map)?;
         let mut cols = table.columns.into_iter();
         let mut next = || cols.next().unwrap_or_default();
         let t_s = next();
-        let int_mm = [next(), next(), next()];
+        let mut int_mm = [next(), next(), next()];
         let ext_mm = [next(), next(), next()];
+        place(&mut int_mm)?;
         let names = mapped_names(&table.names);
         let series = CircleSeries::from_parts(
             name.to_string(),

@@ -1,5 +1,6 @@
 //! EIJ table (docs/commands.md): `plane,direction,accel_m_s2,parameter,value_um_s2_per_m` and
-//! optionally `std_err_um_s2_per_m`, one row per parameter value. For values taken from a
+//! optionally `std_err_um_s2_per_m`, `radius_mm` and the circle centre `position_x_mm`,
+//! `position_y_mm`, `position_z_mm`, one row per parameter value. For values taken from a
 //! report, typed by hand, or written by `eij evaluate --csv-out`.
 
 use std::fmt::Write as _;
@@ -54,6 +55,14 @@ pub(crate) const COLUMNS: [&str; 5] = [
 ];
 /// The optional standard-error column.
 pub(crate) const STD_ERR_COLUMN: &str = "std_err_um_s2_per_m";
+/// The optional columns of the test's conditions: its set radius and circle centre, written
+/// by `eij evaluate --csv-out` so that identify places every test where it was run.
+pub(crate) const CONDITION_COLUMNS: [&str; 4] = [
+    "radius_mm",
+    "position_x_mm",
+    "position_y_mm",
+    "position_z_mm",
+];
 
 /// One parameter value of one test condition.
 #[derive(Debug, Clone, PartialEq)]
@@ -70,6 +79,10 @@ pub struct EijRow {
     pub value: f64,
     /// Standard error, µm·s²/m, where known.
     pub std_err: Option<f64>,
+    /// Set radius of the test, mm, where the table gives it (`radius_mm`).
+    pub radius_mm: Option<f64>,
+    /// Circle centre of the test, x, y, z, mm, where the table gives it (`position_x_mm`, …).
+    pub position_mm: Option<[f64; 3]>,
 }
 
 /// The six rows of one evaluated circle test.
@@ -85,12 +98,35 @@ pub fn rows_from_result(result: &CircleResult) -> Vec<EijRow> {
             parameter: *p,
             value: result.eij[p].value,
             std_err: result.eij.std_err(p),
+            radius_mm: None,
+            position_mm: None,
+        })
+        .collect()
+}
+
+/// The six rows of one evaluated test with its set radius and circle centre (where its
+/// conditions give one; missing trailing axes 0).
+pub fn rows_of_test(t: &super::suite::EvaluatedTest) -> Vec<EijRow> {
+    let position_mm = t.input.test.position_mm.as_ref().map(|p| {
+        let mut xyz = [0.0; 3];
+        for (dst, src) in xyz.iter_mut().zip(p) {
+            *dst = *src;
+        }
+        xyz
+    });
+    rows_from_result(&t.result)
+        .into_iter()
+        .map(|r| EijRow {
+            radius_mm: Some(t.result.radius_mm),
+            position_mm,
+            ..r
         })
         .collect()
 }
 
 /// Reads an EIJ table strictly: header with the five required columns (any order), the
-/// optional standard-error column, nothing else; every row a known plane and direction, a
+/// optional standard-error column, the optional set radius `radius_mm` and circle centre
+/// (`position_x_mm`, `position_y_mm`, `position_z_mm`, all three or none), nothing else; every row a known plane and direction, a
 /// positive finite acceleration, a parameter of that plane, a finite value and, where given,
 /// a finite positive standard error (an empty cell means unknown); no parameter of a test
 /// (plane, direction, acceleration) twice. At least one row. Separator `,`, `;` or tab (decimal
@@ -119,7 +155,14 @@ pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<Vec<EijRow>, MeasuredError
     };
     let mut counter = LineCounter::new(bytes);
     let mut records = reader.records();
-    let expected = || format!("{},{}", COLUMNS.join(","), STD_ERR_COLUMN);
+    let expected = || {
+        format!(
+            "{},{},{}",
+            COLUMNS.join(","),
+            STD_ERR_COLUMN,
+            CONDITION_COLUMNS.join(",")
+        )
+    };
     let header = match records.next() {
         None => {
             return Err(MeasuredError::Empty {
@@ -137,6 +180,10 @@ pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<Vec<EijRow>, MeasuredError
         COLUMNS[3],
         COLUMNS[4],
         STD_ERR_COLUMN,
+        CONDITION_COLUMNS[0],
+        CONDITION_COLUMNS[1],
+        CONDITION_COLUMNS[2],
+        CONDITION_COLUMNS[3],
     ];
     // An unknown column is refused: a typo must not drop the standard errors silently.
     let index = column_indices(&header, &wanted, &header_at, |cell| {
@@ -147,6 +194,11 @@ pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<Vec<EijRow>, MeasuredError
         })
     })?;
     require_columns(&index[..COLUMNS.len()], &COLUMNS, &header_at)?;
+    // The circle centre is three columns or none.
+    let position = &index[7..10];
+    if position.iter().any(|i| *i != usize::MAX) {
+        require_columns(position, &CONDITION_COLUMNS[1..], &header_at)?;
+    }
     let mut rows = Vec::new();
     let mut seen = std::collections::HashMap::new();
     for record in records {
@@ -223,14 +275,26 @@ pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<Vec<EijRow>, MeasuredError
                 }
             },
         };
-        let key = (plane, direction, accel_m_s2.to_bits(), parameter);
+        let (radius_mm, position_mm) = conditions(&record, &index, &name, line, &number)?;
+        let key = (
+            plane,
+            direction,
+            accel_m_s2.to_bits(),
+            parameter,
+            radius_mm.map(f64::to_bits),
+            position_mm.map(|p| p.map(f64::to_bits)),
+        );
         if let Some(first) = seen.insert(key, line) {
             return Err(bad(
                 3,
                 format!(
-                    "{parameter} of {plane} {direction} at {} m/s² given twice \
+                    "{parameter} of {plane} {direction} at {} m/s²{} given twice \
                      (first on line {first})",
-                    num(accel_m_s2)
+                    num(accel_m_s2),
+                    position_mm.map_or(String::new(), |p| format!(
+                        " at {} mm",
+                        crate::text::nums(&p)
+                    ))
                 ),
             ));
         }
@@ -241,6 +305,8 @@ pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<Vec<EijRow>, MeasuredError
             parameter,
             value,
             std_err,
+            radius_mm,
+            position_mm,
         });
     }
     if rows.is_empty() {
@@ -254,16 +320,88 @@ pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<Vec<EijRow>, MeasuredError
     Ok(rows)
 }
 
-/// The table as CSV text; the standard-error column is written when any row has one (empty
-/// cells for the others). Numbers use the shortest representation that reads back exactly.
+/// The set radius and circle centre of one row (empty cells: not given), checked: a radius in
+/// (0, 3] mm, a centre of three finite values within ±1e5 mm or none.
+fn conditions(
+    record: &csv::StringRecord,
+    index: &[usize; 10],
+    name: &str,
+    line: u64,
+    number: &dyn Fn(&str, u64, &str) -> Result<f64, MeasuredError>,
+) -> Result<(Option<f64>, Option<[f64; 3]>), MeasuredError> {
+    let cell = |k: usize| match index[k] {
+        usize::MAX => None,
+        i => Some(record.get(i).unwrap_or("")).filter(|t| !t.is_empty()),
+    };
+    let bad = |column: &str, message: String| MeasuredError::BadValue {
+        at: Location::file_line(name, line),
+        column: column.to_string(),
+        message,
+    };
+    let radius_mm = match cell(6) {
+        None => None,
+        Some(t) => {
+            let r = number(t, line, CONDITION_COLUMNS[0])?;
+            if !(r > 0.0 && r <= 3.0) {
+                return Err(bad(
+                    CONDITION_COLUMNS[0],
+                    format!("{} must lie in (0, 3] mm", num(r)),
+                ));
+            }
+            Some(r)
+        }
+    };
+    let cells = [cell(7), cell(8), cell(9)];
+    let position_mm = match cells {
+        [None, None, None] => None,
+        [Some(x), Some(y), Some(z)] => {
+            let mut p = [0.0; 3];
+            for (k, (v, t)) in p.iter_mut().zip([x, y, z]).enumerate() {
+                *v = number(t, line, CONDITION_COLUMNS[k + 1])?;
+                if v.abs() > 1e5 {
+                    return Err(bad(
+                        CONDITION_COLUMNS[k + 1],
+                        format!("{} mm is beyond ±1e5 mm", num(*v)),
+                    ));
+                }
+            }
+            Some(p)
+        }
+        _ => {
+            let k = cells.iter().position(Option::is_none).unwrap_or(0);
+            return Err(bad(
+                CONDITION_COLUMNS[k + 1],
+                "empty while other position cells of the row are given (a circle centre \
+                 needs x, y and z, or none)"
+                    .into(),
+            ));
+        }
+    };
+    Ok((radius_mm, position_mm))
+}
+
+/// The table as CSV text; the standard-error column is written when any row has one, the
+/// radius and the circle-centre columns when any row has them (empty cells for the others).
+/// Numbers use the shortest representation that reads back exactly.
 pub fn to_csv(rows: &[EijRow]) -> String {
     let with_se = rows.iter().any(|r| r.std_err.is_some());
+    let with_radius = rows.iter().any(|r| r.radius_mm.is_some());
+    let with_position = rows.iter().any(|r| r.position_mm.is_some());
     let mut out = COLUMNS.join(",");
     if with_se {
         out.push(',');
         out.push_str(STD_ERR_COLUMN);
     }
+    if with_radius {
+        out.push(',');
+        out.push_str(CONDITION_COLUMNS[0]);
+    }
+    if with_position {
+        out.push(',');
+        out.push_str(&CONDITION_COLUMNS[1..].join(","));
+    }
     out.push('\n');
+    let opt = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v}"));
     for r in rows {
         let _ = write!(
             out,
@@ -271,9 +409,15 @@ pub fn to_csv(rows: &[EijRow]) -> String {
             r.plane, r.direction, r.accel_m_s2, r.parameter, r.value
         );
         if with_se {
-            out.push(',');
-            if let Some(s) = r.std_err {
-                let _ = write!(out, "{s}");
+            let _ = write!(out, ",{}", opt(r.std_err));
+        }
+        if with_radius {
+            let _ = write!(out, ",{}", opt(r.radius_mm));
+        }
+        if with_position {
+            let p = r.position_mm;
+            for k in 0..3 {
+                let _ = write!(out, ",{}", opt(p.map(|p| p[k])));
             }
         }
         out.push('\n');

@@ -31,16 +31,17 @@ pub(crate) struct CircleGroup<'a> {
 /// `xy · 5 m/s² · circle centre [150, -100, 0] mm`.
 fn group_title(t: &EvaluatedTest) -> String {
     let r = &t.result;
-    let centre = t
-        .input
-        .position_mm
-        .as_deref()
-        .map_or("circle centre not stated".into(), |p| {
-            format!(
-                "circle centre [{}] mm",
-                position_label(p).replace(',', ", ")
-            )
-        });
+    let centre =
+        t.input
+            .test
+            .position_mm
+            .as_deref()
+            .map_or("circle centre not stated".into(), |p| {
+                format!(
+                    "circle centre [{}] mm",
+                    position_label(p).replace(',', ", ")
+                )
+            });
     format!(
         "Circle plot {} · {} m/s² · {centre}",
         r.plane,
@@ -84,11 +85,11 @@ pub(crate) fn groups(suite: &Suite) -> Result<Vec<CircleGroup<'_>>, ReportError>
     }
     // Circle centres in the order the inputs first name them.
     let centre_rank = |g: &CircleGroup| {
-        let p = &g.tests[0].input.position_mm;
+        let p = &g.tests[0].input.test.position_mm;
         suite
             .tests
             .iter()
-            .position(|t| t.input.position_mm == *p)
+            .position(|t| t.input.test.position_mm == *p)
             .unwrap_or(0)
     };
     out.sort_by_key(|g| {

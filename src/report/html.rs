@@ -12,14 +12,15 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use super::labels::{
-    conditions_line, distinct, feed_mm_min, fmt_eij, folder_and_name, folders_of, position_label,
-    test_name,
+    conditions_line, distinct, feed_mm_min, fmt_eij, folder_and_name, folders_of_tests,
+    position_label, test_name,
 };
 pub use super::page::Figure;
 use super::page::{anchor, escape, Page};
 use super::verdict::{self, LoadedIdent};
 use super::{
-    certificate, circle_group, compare, diagnosis_html, ident_html, model_compare, move_svg, short,
+    certificate, circle_group, clocks_html, compare, diagnosis_html, ident_html, model_compare,
+    move_svg, short,
     Conditions, MoveData, ReportError,
 };
 use crate::axes::Plane;
@@ -215,7 +216,7 @@ pub fn generate(req: &ReportRequest) -> Result<PathBuf, ReportError> {
                 machines_elsewhere: machines(&idents),
                 written: format!("{date} by eij {}", env!("CARGO_PKG_VERSION")),
                 conditions: conditions_line(&suite.tests),
-                folders: folders_of(files.iter().map(PathBuf::as_path)).join("; "),
+                folders: folders_of_tests(&suite.tests).join("; "),
             },
         );
     }
@@ -226,6 +227,7 @@ pub fn generate(req: &ReportRequest) -> Result<PathBuf, ReportError> {
         page.heading(2, "circles", "Circle tests");
         let mut h = String::new();
         circle_tables(&mut h, &suite.tests);
+        clocks_html::section(&mut h, &suite);
         page.push(&h);
         circle_group::section(
             &mut page,
@@ -348,7 +350,7 @@ fn header_html(
         if files.is_empty() {
             "none given: no circle test on this page".into()
         } else {
-            folders_of(files.iter().map(PathBuf::as_path)).join("; ")
+            folders_of_tests(&suite.tests).join("; ")
         },
     ));
     if !suite.tests.is_empty() {
@@ -529,7 +531,8 @@ fn circle_tables(h: &mut String, circles: &[EvaluatedTest]) {
                 "<tr><td>{i}</td><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{}</td><td>{:.3}</td><td>{:.0}</td><td>{}</td>",
                 escape(&folder_and_name(c.input.primary_file())),
                 c.input
-                    .position_mm
+                    .test
+                .position_mm
                     .as_deref()
                     .map_or("–".into(), position_label),
                 r.direction,

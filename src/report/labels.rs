@@ -12,7 +12,7 @@ use crate::rtest::CircleResult;
 /// The name of a test with its circle centre: `pos-a/xy_ccw_2.csv @ 150,-100,0 mm`.
 pub(crate) fn test_name(t: &EvaluatedTest) -> String {
     let name = folder_and_name(t.input.primary_file());
-    match &t.input.position_mm {
+    match &t.input.test.position_mm {
         Some(p) => format!("{name} @ {} mm", position_label(p)),
         None => name,
     }
@@ -41,6 +41,7 @@ pub(crate) fn conditions_line(t: &[EvaluatedTest]) -> String {
         .iter()
         .map(|t| {
             t.input
+                .test
                 .position_mm
                 .as_deref()
                 .map_or("not stated".into(), |p| {
@@ -77,6 +78,26 @@ pub(crate) fn folder_and_name(path: &Path) -> String {
 /// The folders of `files` with the number of files in each, in order of appearance:
 /// `measurements/demo-vmc/pos-a (18 files)`.
 pub(crate) fn folders_of<'a>(files: impl Iterator<Item = &'a Path>) -> Vec<String> {
+    count_by_folder(files, "file")
+}
+
+/// The folders of the tests, each with its number of tests (a two-system test counts once), in
+/// order of appearance: `measurements/demo-vmc/pos-a (18 tests)`. A test's folder is that of
+/// its `rtest.toml`, else of its file.
+pub(crate) fn folders_of_tests(tests: &[EvaluatedTest]) -> Vec<String> {
+    count_by_folder(
+        tests.iter().map(|t| {
+            t.input
+                .conditions_file
+                .as_deref()
+                .unwrap_or(t.input.primary_file())
+        }),
+        "test",
+    )
+}
+
+/// The folders of `files`, each with the number of `noun`s (one per file) in it.
+fn count_by_folder<'a>(files: impl Iterator<Item = &'a Path>, noun: &str) -> Vec<String> {
     let mut folders: Vec<(String, usize)> = Vec::new();
     for f in files {
         let dir = f
@@ -91,7 +112,7 @@ pub(crate) fn folders_of<'a>(files: impl Iterator<Item = &'a Path>) -> Vec<Strin
     }
     folders
         .into_iter()
-        .map(|(d, n)| format!("{d} ({n} file{})", if n == 1 { "" } else { "s" }))
+        .map(|(d, n)| format!("{d} ({n} {noun}{})", if n == 1 { "" } else { "s" }))
         .collect()
 }
 

@@ -31,6 +31,7 @@ use std::path::Path;
 pub(crate) mod certificate;
 pub(crate) mod circle;
 pub(crate) mod circle_group;
+pub(crate) mod clocks_html;
 pub(crate) mod compare;
 pub(crate) mod diagnosis_html;
 pub(crate) mod history_html;

@@ -9,6 +9,7 @@ pub mod diagnosis_demo;
 pub mod imperfect;
 pub mod mutation;
 pub mod random_machine;
+pub mod shop;
 pub mod synth;
 pub mod traces;
 
@@ -213,6 +214,22 @@ pub fn chain(e: &dyn std::error::Error) -> String {
         source = s.source();
     }
     text
+}
+
+/// `(name, identified, std_err)` of every parameter of an identify report (JSON).
+pub fn identified(report: &serde_json::Value) -> Vec<(String, f64, f64)> {
+    report["parameters"]
+        .as_array()
+        .expect("parameters")
+        .iter()
+        .map(|p| {
+            (
+                p["name"].as_str().unwrap_or_default().to_string(),
+                p["identified"].as_f64().unwrap_or(f64::NAN),
+                p["std_err"].as_f64().unwrap_or(f64::NAN),
+            )
+        })
+        .collect()
 }
 
 /// What a run of the binary gave, as text.

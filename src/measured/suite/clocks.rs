@@ -5,11 +5,11 @@
 use super::{group_key, series_at, Data, Prepared, SuiteOptions};
 use crate::measured::inputs::TestInput;
 use crate::measured::MeasuredError;
-use crate::rtest::clock::{self, Recording};
+use crate::rtest::clock;
 use crate::rtest::clock_fit::{fit_offset, OffsetFit, OffsetTest};
 use crate::rtest::error::{Location, RtestError};
 use crate::rtest::normalise::{normalise, Normalised};
-use crate::rtest::{CircleSeries, EvalOptions, Warning};
+use crate::rtest::Warning;
 
 /// How a test's clock offset was found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -93,23 +93,6 @@ const SAME_CLOCK_SPREAD_S: f64 = 2e-3;
 /// ambiguous (a record without start or stop of the motion).
 const UNIQUE_ALIGNMENT_RATIO: f64 = 3.0;
 
-/// The internal recording alone, as a series, to find its circle and period.
-fn internal_period(
-    input: &TestInput,
-    r: &Recording,
-    opts: &EvalOptions,
-) -> Result<f64, RtestError> {
-    let s = CircleSeries::new(r.source.clone(), r.t_s.clone(), r.mm.clone(), r.mm.clone())?;
-    let norm = normalise(&s, opts).map_err(|e| match e {
-        RtestError::TooShort { detail, .. } => RtestError::TooShort {
-            at: Location::source(&input.name()),
-            detail,
-        },
-        e => e,
-    })?;
-    Ok(std::f64::consts::TAU / norm.omega_rad_s.abs())
-}
-
 /// Two-system tests of one clock: aligned one by one on their trajectories, then (one constant
 /// offset) refined by the joint fit where the tests separate it from cross-talk.
 pub(super) fn align_clock(
@@ -124,11 +107,13 @@ pub(super) fn align_clock(
         let Data::Split { internal, external } = &prepared[i].data else {
             continue;
         };
-        if let Some(o) = inputs[i].time_offset_ms {
+        if let Some(o) = inputs[i].test.time_offset_ms {
             offsets[i] = Some(TimeOffset::given(o, clock));
             continue;
         }
-        let period = internal_period(&inputs[i], internal, &prepared[i].opts)?;
+        let Some(period) = prepared[i].period_s else {
+            continue;
+        };
         let a = clock::align(internal, external, period)?;
         if a.next_best_rms_um < UNIQUE_ALIGNMENT_RATIO * a.rms_um {
             return Err(RtestError::Pooling {
@@ -260,7 +245,7 @@ pub(super) fn lag_of_clock(
 ) -> Result<Vec<ClockReport>, MeasuredError> {
     let mut free = Vec::new();
     for &i in members {
-        match inputs[i].time_offset_ms {
+        match inputs[i].test.time_offset_ms {
             Some(o) => offsets[i] = Some(TimeOffset::given(o, clock)),
             None => free.push((i, 0.0)),
         }

@@ -112,7 +112,7 @@ fn diagnose_test(
     let opts = settings.over(t.input.diagnosis).options();
     let mut d = diagnose_series(&t.series, &eval, &opts)?;
     d.name = t.input.name();
-    d.position_mm = t.input.position_mm.as_deref().map(|p| {
+    d.position_mm = t.input.test.position_mm.as_deref().map(|p| {
         let mut xyz = [0.0; 3];
         for (dst, src) in xyz.iter_mut().zip(p) {
             *dst = *src;

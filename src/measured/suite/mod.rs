@@ -16,6 +16,7 @@ use rayon::prelude::*;
 
 mod clocks;
 pub mod diagnose;
+mod partners;
 use clocks::{align_clock, lag_of_clock};
 pub use clocks::{clocks_json, ClockReport, OffsetSource, TimeOffset};
 
@@ -109,6 +110,8 @@ pub(super) struct Prepared {
     opts: EvalOptions,
     source: RadiusSource,
     data: Data,
+    /// Period of the internal recording's circle, s (two-system tests).
+    period_s: Option<f64>,
 }
 
 pub(super) enum Data {
@@ -120,8 +123,12 @@ pub(super) enum Data {
 }
 
 fn eval_options(input: &TestInput, opts: &SuiteOptions) -> (EvalOptions, RadiusSource) {
-    let plane = opts.plane.or(input.plane);
-    let (radius_mm, source) = match (opts.radius_mm, input.radius_mm, opts.fallback_radius_mm) {
+    let plane = opts.plane.or(input.test.plane);
+    let (radius_mm, source) = match (
+        opts.radius_mm,
+        input.test.radius_mm,
+        opts.fallback_radius_mm,
+    ) {
         (Some(r), _, _) => (Some(r), RadiusSource::CommandLine),
         (None, Some(r), _) => (Some(r), RadiusSource::Conditions),
         (None, None, Some(r)) => (Some(r), RadiusSource::Fallback),
@@ -132,7 +139,7 @@ fn eval_options(input: &TestInput, opts: &SuiteOptions) -> (EvalOptions, RadiusS
 
 /// The tests of one E group share plane and position.
 pub(super) fn group_key(input: &TestInput, norm: &Normalised) -> String {
-    match &input.position_mm {
+    match &input.test.position_mm {
         None => norm.plane.to_string(),
         Some(p) => {
             let p: Vec<String> = p.iter().map(|v| format!("{v}")).collect();
@@ -148,21 +155,33 @@ pub fn evaluate_tests(inputs: &[TestInput], opts: &SuiteOptions) -> Result<Suite
         .par_iter()
         .map(|input| -> Result<Prepared, MeasuredError> {
             let (eval, source) = eval_options(input, opts);
-            let data = match &input.data {
-                DataFiles::Single(_) => Data::Single(input.read_single()?),
-                DataFiles::Split { internal, external } => Data::Split {
-                    internal: super::recording::read_internal(
+            let (data, period_s) = match &input.test.data {
+                DataFiles::Single(_) => (Data::Single(input.read_single()?), None),
+                DataFiles::Split { internal, external } => {
+                    let mut int =
+                        super::recording::read_internal(
                         internal,
                         &input.internal_columns,
                         eval.plane,
-                    )?,
-                    external: super::recording::read_external(external, &input.external_columns)?,
-                },
+                    )?;
+                    let name = int.source.clone();
+                    super::coordinates::place(&input.placement(), &name, &mut int.mm)?;
+                    let ext = super::recording::read_external(external, &input.external_columns)?;
+                    let period = partners::check(input, &int, &ext, &eval)?;
+                    (
+                        Data::Split {
+                            internal: int,
+                            external: ext,
+                        },
+                        Some(period),
+                    )
+                }
             };
             Ok(Prepared {
                 opts: eval,
                 source,
                 data,
+                period_s,
             })
         })
         .collect::<Vec<_>>()
@@ -294,7 +313,7 @@ fn condition_warnings(input: &TestInput, r: &CircleResult, source: RadiusSource)
             mean_internal_radius_mm: r.measured_radius_mm,
         });
     }
-    if let Some(d) = input.direction {
+    if let Some(d) = input.test.direction {
         if d != r.direction {
             w.push(Warning::DirectionDisagrees {
                 stated: d,
@@ -303,7 +322,7 @@ fn condition_warnings(input: &TestInput, r: &CircleResult, source: RadiusSource)
             });
         }
     }
-    if let Some(feed) = input.feed_mm_min {
+    if let Some(feed) = input.test.feed_mm_min {
         let measured = r.freq_hz * std::f64::consts::TAU * r.radius_mm * 60.0;
         if (measured / feed - 1.0).abs() > 0.05 {
             w.push(Warning::FeedDisagrees {
@@ -322,7 +341,7 @@ fn pairs(tests: &[EvaluatedTest]) -> Vec<Bidirectional> {
     let same = |a: &EvaluatedTest, b: &EvaluatedTest| {
         let (ra, rb) = (&a.result, &b.result);
         ra.plane == rb.plane
-            && a.input.position_mm == b.input.position_mm
+            && a.input.test.position_mm == b.input.test.position_mm
             && a.input.clock_group == b.input.clock_group
             && (ra.radius_mm - rb.radius_mm).abs() <= 1e-9 * ra.radius_mm
             && ra.accel_m_s2.max(rb.accel_m_s2)
@@ -387,8 +406,8 @@ impl EvaluatedTest {
                 clock: o.clock.clone(),
                 alignment_ms: o.alignment_ms,
             }),
-            position_mm: self.input.position_mm.clone(),
-            note: self.input.note.clone(),
+            position_mm: self.input.test.position_mm.clone(),
+            note: self.input.test.note.clone(),
             machine: self.input.session.machine.clone(),
             date: self.input.session.date.clone(),
         }
