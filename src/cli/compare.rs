@@ -100,7 +100,8 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
             warnings = prep
                 .warnings
                 .iter()
-                .map(super::advice::identify_warning)
+                .cloned()
+                .map(|w| super::advice::identify_warning(&eij::ident::Warning::Measured(w)))
                 .collect();
         }
         candidates.push(Candidate {

@@ -78,7 +78,7 @@ impl Clone for Problem {
 
 /// The weighted error Jacobian, the weighted errors, and the parameters whose difference was
 /// one-sided ([`Problem::error_jacobian_edges`]).
-pub type JacobianEdges = (DMatrix<f64>, DVector<f64>, Vec<usize>);
+pub(crate) type JacobianEdges = (DMatrix<f64>, DVector<f64>, Vec<usize>);
 
 impl Problem {
     /// Checks that the model can run every test and builds the problem.

@@ -262,7 +262,7 @@ fn recording_order(
     let mut spans = Vec::with_capacity(files.len());
     for f in files {
         let r = if internal {
-            read_internal(f, map)?
+            read_internal(f, map, None)?
         } else {
             read_external(f, map)?
         };

@@ -32,10 +32,10 @@ impl TestInput {
     /// # }
     /// ```
     pub fn read_internal(&self) -> Result<Option<InternalRecording>, MeasuredError> {
-        let DataFiles::Split { internal, .. } = &self.data else {
+        let DataFiles::Split { internal, .. } = &self.test.data else {
             return Ok(None);
         };
-        let r = read_internal(internal, &self.internal_columns, self.plane)?;
+        let r = read_internal(internal, &self.internal_columns, self.test.plane)?;
         Ok(Some(InternalRecording {
             lines: r.lines.unwrap_or_default(),
             t_s: r.t_s,
