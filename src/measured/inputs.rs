@@ -10,6 +10,8 @@ use super::conditions::{
 };
 use super::error::MeasuredError;
 use super::layout::ColumnMap;
+use super::recording::read_internal;
+use super::traces::InternalRecording;
 use crate::io::FileId;
 use crate::rtest::diagnosis::tolerance::Tolerances;
 use crate::rtest::CircleSeries;
@@ -493,5 +495,35 @@ impl MeasuredInputs {
             }
         }
         files
+    }
+}
+
+impl TestInput {
+    /// Reads the internal file of a two-system test (`[[test]]` with `internal` and
+    /// `external`): a TNCscope export, a Sinumerik trace or delimited text, with the test's
+    /// column map and plane. `None` for a single-file test.
+    ///
+    /// ```no_run
+    /// use eij::measured::inputs::expand_tests;
+    ///
+    /// # fn main() -> Result<(), eij::measured::MeasuredError> {
+    /// let tests = expand_tests(&["shop/cnc-and-rtest".into()])?;
+    /// if let Some(r) = tests[0].read_internal()? {
+    ///     println!("{} samples, first x {} mm", r.t_s.len(), r.mm[0][0]);
+    /// }
+    /// # Ok(())
+    /// # }
+    /// ```
+    pub fn read_internal(&self) -> Result<Option<InternalRecording>, MeasuredError> {
+        let DataFiles::Split { internal, .. } = &self.test.data else {
+            return Ok(None);
+        };
+        let r = read_internal(internal, &self.internal_columns, self.test.plane)?;
+        Ok(Some(InternalRecording {
+            lines: r.lines.unwrap_or_default(),
+            t_s: r.t_s,
+            mm: r.mm,
+            absent: r.absent,
+        }))
     }
 }

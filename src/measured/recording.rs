@@ -4,46 +4,14 @@
 
 use std::path::Path;
 
-use super::conditions::DataFiles;
 use super::error::MeasuredError;
-use super::inputs::TestInput;
 use super::layout::{read_table, ColumnMap};
 use super::series::read_file;
-use super::traces::{format_of, Format, InternalRecording};
+use super::traces::{format_of, Format};
 use crate::axes::Plane;
 use crate::rtest::clock::Recording;
 use crate::rtest::series::{EXT_COLUMNS, INT_COLUMNS, TIME_COLUMN};
 use crate::rtest::Location;
-
-impl TestInput {
-    /// Reads the internal file of a two-system test (`[[test]]` with `internal` and
-    /// `external`): a TNCscope export, a Sinumerik trace or delimited text, with the test's
-    /// column map and plane. `None` for a single-file test.
-    ///
-    /// ```no_run
-    /// use eij::measured::inputs::expand_tests;
-    ///
-    /// # fn main() -> Result<(), eij::measured::MeasuredError> {
-    /// let tests = expand_tests(&["shop/cnc-and-rtest".into()])?;
-    /// if let Some(r) = tests[0].read_internal()? {
-    ///     println!("{} samples, first x {} mm", r.t_s.len(), r.mm[0][0]);
-    /// }
-    /// # Ok(())
-    /// # }
-    /// ```
-    pub fn read_internal(&self) -> Result<Option<InternalRecording>, MeasuredError> {
-        let DataFiles::Split { internal, .. } = &self.test.data else {
-            return Ok(None);
-        };
-        let r = read_internal(internal, &self.internal_columns, self.test.plane)?;
-        Ok(Some(InternalRecording {
-            lines: r.lines.unwrap_or_default(),
-            t_s: r.t_s,
-            mm: r.mm,
-            absent: r.absent,
-        }))
-    }
-}
 
 /// Reads the internal file of a two-system test: a controller trace (TNCscope, Sinumerik,
 /// [`super::traces`], recognised by content), else delimited text with `t_s` and
