@@ -23,12 +23,6 @@ impl CircleSeries {
     pub fn read_csv_with(path: impl AsRef<Path>, map: &ColumnMap) -> Result<Self, MeasuredError> {
         let path = path.as_ref();
         let bytes = read_file(path)?;
-        if super::traces::format_of(&bytes) != super::traces::Format::Delimited {
-            return Err(MeasuredError::Trace {
-                at: Location::source(&path.display().to_string()),
-                message: "a controller trace holds only the axes' own readings: pair it with the R-Test file in rtest.toml ([[test]] internal = this file, external = the R-Test file)".into(),
-            });
-        }
         Self::from_csv_bytes_with(&path.display().to_string(), &bytes, map)
     }
 
@@ -55,6 +49,12 @@ impl CircleSeries {
         map: &ColumnMap,
         place: impl FnOnce(&mut [Vec<f64>; 3]) -> Result<(), MeasuredError>,
     ) -> Result<Self, MeasuredError> {
+        if super::traces::format_of(bytes) != super::traces::Format::Delimited {
+            return Err(MeasuredError::Trace {
+                at: Location::source(name),
+                message: "a controller trace holds only the axes' own readings: pair it with the R-Test file in rtest.toml ([[test]] internal = this file, external = the R-Test file)".into(),
+            });
+        }
         let table = read_table(name, bytes, &CONTRACT_COLUMNS, map)?;
         let mut cols = table.columns.into_iter();
         let mut next = || cols.next().unwrap_or_default();
