@@ -204,7 +204,7 @@ pub(crate) fn polar_svg(fig: &PolarFigure, scale: &PolarScale) -> Result<String,
             .map(|(l, p)| Entry::new(l.clone(), direction_color(p.direction), Mark::Line))
             .collect();
         entries.push(Entry::new(
-            "start of the steady revolutions (dot), direction of travel (arrow)",
+            "start (dot) and direction of travel (arrow)",
             svg::SET,
             Mark::Dot,
         ));
@@ -389,7 +389,7 @@ pub(crate) fn out_of_plane_svg(
     let header_px = 16 + 30 + 22 * lines.len() as u32 + 6;
     let dec = svg::decimals_for(hi - lo);
     let legend_px = 24 * (series.len() as u32 + 1) + 30;
-    svg::render((470, header_px + 300 + legend_px), |root| {
+    svg::render((500, header_px + 300 + legend_px), |root| {
         let body = svg::header(root, title, lines)?;
         let (top, bottom) = body.split_vertically(300);
         let mut chart = ChartBuilder::on(&top)
