@@ -57,17 +57,19 @@ pub(crate) struct Placement<'a> {
 
 /// Makes the internal readings `int` (x, y, z, mm) of the file `name` relative to the circle
 /// centre: subtracts `position_mm` where the internal coordinates are absolute, and refuses
-/// readings that do not lie about the centre (see the module docs).
+/// readings that do not lie about the centre (see the module docs). `absent` axes (a trace of
+/// the plane's two axes) hold 0, the axis at the centre, and are left alone.
 pub(crate) fn place(
     how: &Placement,
     name: &str,
     int: &mut [Vec<f64>; 3],
+    absent: [bool; 3],
 ) -> Result<(), MeasuredError> {
     let n = int[0].len();
     if n == 0 || int.iter().any(|c| c.len() != n) {
         return Ok(()); // the series' own checks name what is wrong
     }
-    let mean = int.each_ref().map(|c| c.iter().sum::<f64>() / n as f64);
+    let mut mean = int.each_ref().map(|c| c.iter().sum::<f64>() / n as f64);
     if !mean.iter().all(|m| m.is_finite()) {
         return Ok(());
     }
@@ -93,7 +95,17 @@ pub(crate) fn place(
         key: "internal_coordinates".into(),
         message,
     };
-    match (how.absolute, centre(how.position_mm)) {
+    let centre = centre(how.position_mm).map(|mut c| {
+        // An absent axis stands at the centre in either coordinates.
+        for k in 0..3 {
+            if absent[k] {
+                c[k] = 0.0;
+                mean[k] = 0.0;
+            }
+        }
+        c
+    });
+    match (how.absolute, centre) {
         (true, Some(c)) => {
             let relative = [mean[0] - c[0], mean[1] - c[1], mean[2] - c[2]];
             if !near(&relative, &zero) {
@@ -136,5 +148,42 @@ pub(crate) fn place(
                 point(&c)
             ))
         ))),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A circle of radius 2 mm about `c` in x, y, sampled at 100 instants.
+    fn xy_circle(c: [f64; 2]) -> [Vec<f64>; 3] {
+        let phi = (0..100).map(|k| k as f64 * std::f64::consts::TAU / 100.0);
+        [
+            phi.clone().map(|p| c[0] + 2.0 * p.cos()).collect(),
+            phi.map(|p| c[1] + 2.0 * p.sin()).collect(),
+            vec![0.0; 100],
+        ]
+    }
+
+    #[test]
+    fn an_absent_axis_stays_at_the_centre_in_absolute_coordinates() {
+        let centre = [150.0, -100.0, -200.0];
+        let how = Placement {
+            absolute: true,
+            position_mm: Some(&centre),
+            conditions: None,
+        };
+        // A trace of X and Y only: Z is absent and holds 0 (the axis at the centre).
+        let mut int = xy_circle([150.0, -100.0]);
+        place(&how, "xy.sco", &mut int, [false, false, true]).unwrap();
+        // x, y relative to the centre: a circle of radius 2 about 0; z untouched (not +200).
+        for k in 0..100 {
+            let r = int[0][k].hypot(int[1][k]);
+            assert!((r - 2.0).abs() < 1e-12, "radius {r}");
+            assert_eq!(int[2][k], 0.0);
+        }
+        // Without the absent mark the same readings lie 200 mm from the centre in z: refused.
+        let mut int = xy_circle([150.0, -100.0]);
+        assert!(place(&how, "xy.sco", &mut int, [false; 3]).is_err());
     }
 }

@@ -101,7 +101,7 @@ impl TestInput {
                 let name = f.display().to_string();
                 let bytes = super::series::read_file(f)?;
                 let place = |int: &mut [Vec<f64>; 3]| {
-                    super::coordinates::place(&self.placement(), &name, int)
+                    super::coordinates::place(&self.placement(), &name, int, [false; 3])
                 };
                 CircleSeries::from_csv_placed(&name, &bytes, &self.columns, place)
             }

@@ -20,8 +20,7 @@ use super::page::{anchor, escape, Page};
 use super::verdict::{self, LoadedIdent};
 use super::{
     certificate, circle_group, clocks_html, compare, diagnosis_html, ident_html, model_compare,
-    move_svg, short,
-    Conditions, MoveData, ReportError,
+    move_svg, short, Conditions, MoveData, ReportError,
 };
 use crate::axes::Plane;
 use crate::ident::report::IdentReport;

@@ -158,14 +158,13 @@ pub fn evaluate_tests(inputs: &[TestInput], opts: &SuiteOptions) -> Result<Suite
             let (data, period_s) = match &input.test.data {
                 DataFiles::Single(_) => (Data::Single(input.read_single()?), None),
                 DataFiles::Split { internal, external } => {
-                    let mut int =
-                        super::recording::read_internal(
+                    let mut int = super::recording::read_internal(
                         internal,
                         &input.internal_columns,
                         eval.plane,
                     )?;
                     let name = int.source.clone();
-                    super::coordinates::place(&input.placement(), &name, &mut int.mm)?;
+                    super::coordinates::place(&input.placement(), &name, &mut int.mm, int.absent)?;
                     let ext = super::recording::read_external(external, &input.external_columns)?;
                     let period = partners::check(input, &int, &ext, &eval)?;
                     (
