@@ -99,7 +99,7 @@ impl TestInput {
         match &self.test.data {
             DataFiles::Single(f) => {
                 let name = f.display().to_string();
-                let bytes = super::series::read_file(f)?;
+                let bytes = super::series::read_recording(f)?;
                 let place = |int: &mut [Vec<f64>; 3]| {
                     super::coordinates::place(&self.placement(), &name, int, [false; 3])
                 };

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use super::error::MeasuredError;
 use super::layout::{read_table, ColumnMap};
-use super::series::read_file;
+use super::series::read_recording;
 use super::traces::{format_of, Format};
 use crate::axes::Plane;
 use crate::rtest::clock::Recording;
@@ -22,7 +22,7 @@ pub(crate) fn read_internal(
     plane: Option<Plane>,
 ) -> Result<Recording, MeasuredError> {
     let name = path.display().to_string();
-    let bytes = read_file(path)?;
+    let bytes = read_recording(path)?;
     match format_of(&bytes) {
         Format::Tnc => super::traces::tnc::read(&name, &bytes, map, plane),
         Format::Sinumerik => super::traces::sinumerik::read(&name, &bytes, map, plane),
@@ -33,7 +33,7 @@ pub(crate) fn read_internal(
 /// Reads the external file of a two-system test: `t_s` and `{x,y,z}_ext_mm`.
 pub(crate) fn read_external(path: &Path, map: &ColumnMap) -> Result<Recording, MeasuredError> {
     let name = path.display().to_string();
-    let bytes = read_file(path)?;
+    let bytes = read_recording(path)?;
     if format_of(&bytes) != Format::Delimited {
         return Err(MeasuredError::Trace {
             at: Location::source(&name),

@@ -22,7 +22,7 @@ impl CircleSeries {
     /// `rtest.toml` `[columns]`).
     pub fn read_csv_with(path: impl AsRef<Path>, map: &ColumnMap) -> Result<Self, MeasuredError> {
         let path = path.as_ref();
-        let bytes = read_file(path)?;
+        let bytes = read_recording(path)?;
         Self::from_csv_bytes_with(&path.display().to_string(), &bytes, map)
     }
 
@@ -136,6 +136,49 @@ fn mapped_names(names: &[String]) -> Option<Box<[String; 7]>> {
 /// found" and "is a folder" apart from other failures.
 pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>, MeasuredError> {
     read_bounded(path, crate::io::read::MAX_SERIES_BYTES)
+}
+
+/// As [`read_file`], for a recording (R-Test CSV, controller trace): text that is not UTF-8
+/// given as UTF-8 ([`utf8_of`]).
+pub(crate) fn read_recording(path: &Path) -> Result<Vec<u8>, MeasuredError> {
+    read_file(path).map(utf8_of)
+}
+
+/// `bytes` as UTF-8: UTF-16 with a byte-order mark (`FF FE` or `FE FF`, as spreadsheets write
+/// "Unicode text") decoded; else bytes that are no UTF-8 but hold no NUL read as Latin-1 (ISO
+/// 8859-1, as controls and loggers on Windows write `µm`: byte B5); anything else (binary
+/// data, broken UTF-16) as it is, for the reader to refuse as not UTF-8.
+pub(crate) fn utf8_of(bytes: Vec<u8>) -> Vec<u8> {
+    let little = match bytes.get(..2) {
+        Some([0xFF, 0xFE]) => Some(true),
+        Some([0xFE, 0xFF]) => Some(false),
+        _ => None,
+    };
+    if let Some(little) = little {
+        let body = &bytes[2..];
+        if body.len() % 2 != 0 {
+            return bytes;
+        }
+        let units = body.chunks_exact(2).map(|b| {
+            if little {
+                u16::from_le_bytes([b[0], b[1]])
+            } else {
+                u16::from_be_bytes([b[0], b[1]])
+            }
+        });
+        return match char::decode_utf16(units).collect::<Result<String, _>>() {
+            Ok(s) if !s.contains('\0') => s.into_bytes(),
+            _ => bytes,
+        };
+    }
+    if std::str::from_utf8(&bytes).is_ok() || bytes.contains(&0) {
+        return bytes;
+    }
+    bytes
+        .iter()
+        .map(|&b| b as char)
+        .collect::<String>()
+        .into_bytes()
 }
 
 /// Reads a whole input file of at most `max_bytes` bytes ([`crate::io::read_input`]).

@@ -5,14 +5,7 @@
 
 use super::root;
 
-/// A number as TNCscope writes it: `3.000000000e+003` (ten significant digits, a signed
-/// three-digit exponent).
-pub fn sci(v: f64) -> String {
-    let s = format!("{v:.9e}");
-    let (m, e) = s.split_once('e').unwrap();
-    let e: i32 = e.parse().unwrap();
-    format!("{m}e{}{:03}", if e < 0 { '-' } else { '+' }, e.abs())
-}
+pub use super::shop::sci;
 
 /// The value a cell written by [`sci`] holds.
 pub fn held(v: f64) -> f64 {

@@ -20,6 +20,11 @@ use crate::rtest::clock::Recording;
 use crate::rtest::series::INT_COLUMNS;
 use crate::rtest::Location;
 
+/// Most bytes of a Sinumerik trace eij reads (64 MiB): the XML is parsed whole, its tree
+/// taking about seven times the file in memory. A circle test of 10 s traced at 8 kHz with four
+/// signals is about 7 MB.
+pub(crate) const MAX_XML_BYTES: usize = 64 << 20;
+
 /// One `dataSignal`.
 struct Signal<'a> {
     frame: usize,
@@ -58,6 +63,16 @@ pub(crate) fn read(
     map: &ColumnMap,
     plane: Option<Plane>,
 ) -> Result<Recording, MeasuredError> {
+    if bytes.len() > MAX_XML_BYTES {
+        return Err(MeasuredError::Trace {
+            at: Location::source(source),
+            message: format!(
+                "a Sinumerik trace of {:.1} MiB: eij reads traces of up to {} MiB (the XML is parsed whole, about seven times its size in memory); trace a shorter time or fewer signals",
+                bytes.len() as f64 / f64::from(1u32 << 20),
+                MAX_XML_BYTES >> 20
+            ),
+        });
+    }
     let text = text_of(bytes);
     let starts: Vec<usize> = std::iter::once(0)
         .chain(text.match_indices('\n').map(|(i, _)| i + 1))

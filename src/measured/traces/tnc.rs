@@ -1,17 +1,21 @@
 //! Heidenhain TNCscope text exports (`.sco`, recognised by the first line `%TNCscopeNT data
 //! file`): a `%[GLOBAL]` block (`%SAMPLING=` µs), one `%[CURVEn]` block per channel (`%NAME=`,
-//! `%CHANNELTYPE=`, `%AXISTYPE=`, `%DIMENSION=`, `%CYCLETIME=` µs, `%COLUMN=`), then after
-//! `%[DATA]` one row per sample instant, `time_us; v1; v2; …;`.
+//! `%CHANNELTYPE=`, `%AXISTYPE=`, `%DIMENSION=`, `%COUNT=`, `%CYCLETIME=` µs, `%COLUMN=`), each
+//! block possibly closed by a line holding only `%`, then after `%[DATA]` one row per sample
+//! instant, `time_us; v1; v2; …;`.
 //!
-//! The internal readings are the `s ist` (actual position) channels of X, Y and Z: the channel
-//! type from `%CHANNELTYPE=` (else the part of `%NAME=` before `/`), the axis from `%AXISTYPE=`
-//! (else the part after `/`); a channel whose `%NAME=` is the name `[columns]` gives an
-//! `_int_mm` column is taken for that axis instead. Units from `%DIMENSION=` (`mm`, `µm`/`um`,
-//! `inch`/`in`), time from the first column in µs; other channels are left aside. A channel
-//! without `%COLUMN=` is in the column of its block's order. An empty cell is no sample; a
-//! channel with a `%CYCLETIME=` k times the row interval (`%SAMPLING=`, else the rows' median
-//! interval) whose cells are all filled and hold runs of k equal values from the first row is
-//! read as held and keeps the first row of each run.
+//! The internal readings are the actual-position channels of X, Y and Z (`s ist`, in English
+//! exports `s actual`): the channel type from `%CHANNELTYPE=` (else the part of `%NAME=` before
+//! `/`), the axis from `%AXISTYPE=` (else the part after `/`); a channel whose `%NAME=` is the
+//! name `[columns]` gives an `_int_mm` column is taken for that axis instead. Units from
+//! `%DIMENSION=` (`mm`, `µm`/`um`, `inch`/`in`), time from the first column in µs; other
+//! channels are left aside. A channel without `%COLUMN=` is in the column of its block's order.
+//! An empty cell is no sample; a channel with a `%CYCLETIME=` k times the row interval
+//! (`%SAMPLING=`, else the rows' median interval) whose cells are all filled and hold runs of k
+//! equal values from the first row is read as held and keeps the first row of each run. A
+//! channel's `%COUNT=`, where given, must be the number of its samples, or, for a slower
+//! channel packed into the first rows of its column, the number of those rows (then timed by
+//! its cycle time from the first row).
 
 use super::{assemble, text_of, Channel, Found};
 use crate::axes::{Axis, Plane};
@@ -32,6 +36,8 @@ struct Curve {
     dimension: Option<(String, u64)>,
     cycle_us: Option<f64>,
     column: Option<usize>,
+    /// `%COUNT=` and its line.
+    count: Option<(usize, u64)>,
 }
 
 impl Curve {
@@ -55,6 +61,9 @@ impl Curve {
             .to_uppercase()
     }
 }
+
+/// The channel types of the actual position (German and English TNCscope).
+const ACTUAL_POSITION: [&str; 2] = ["s ist", "s actual"];
 
 enum Section {
     Global,
@@ -143,6 +152,18 @@ pub(crate) fn read(
                     "AXISTYPE" => c.axis_type = Some(value.to_string()),
                     "DIMENSION" => c.dimension = Some((value.to_string(), number)),
                     "CYCLETIME" => c.cycle_us = Some(number_of("CYCLETIME")?),
+                    "COUNT" => {
+                        let n = value.parse::<usize>().map_err(|_| {
+                            bad(
+                                number,
+                                format!(
+                                    "%COUNT={} is not a number of samples (0, 1, 2, …)",
+                                    quote_cell(value)
+                                ),
+                            )
+                        })?;
+                        c.count = Some((n, number));
+                    }
                     "COLUMN" => {
                         c.column =
                             Some(value.parse::<usize>().ok().filter(|&n| n >= 1).ok_or_else(
@@ -187,7 +208,7 @@ pub(crate) fn read(
             Some(i) => vec![i],
             None => (0..curves.len())
                 .filter(|&i| {
-                    curves[i].channel_type() == "s ist"
+                    ACTUAL_POSITION.contains(&curves[i].channel_type().as_str())
                         && curves[i].axis() == axis.letter().to_string()
                 })
                 .collect(),
@@ -281,15 +302,56 @@ pub(crate) fn read(
         }
     }
     let row_us = sampling_us.or_else(|| median_step(&row_times));
+    let first_rows: Vec<u64> = rows.iter().map(|&(n, _)| n).collect();
     for (k, ch) in channels.iter_mut().enumerate() {
-        let (Some(ch), Some(i), Some(row_us)) = (ch.as_mut(), chosen[k], row_us) else {
+        let (Some(ch), Some(i)) = (ch.as_mut(), chosen[k]) else {
             continue;
         };
-        if let Some(cycle) = curves[i].cycle_us {
+        let c = &curves[i];
+        if let (Some(cycle), Some(row_us)) = (c.cycle_us, row_us) {
             thin_held(ch, cycle / row_us, rows.len());
+        }
+        if let Some((count, line)) = c.count {
+            check_count(source, ch, c, count, line, row_us, &first_rows)?;
         }
     }
     assemble(source, channels, plane, &found)
+}
+
+/// Holds a channel to its `%COUNT=`: the samples read (after [`thin_held`]) are that many;
+/// else, where the column holds exactly its first `count` rows and `%CYCLETIME=` is longer
+/// than the row interval, the channel is packed (its samples one after another from the first
+/// row, as TNCscope writes a slower channel beside faster ones) and is timed from its first
+/// row by its cycle time; anything else is refused naming the `%COUNT=` line.
+fn check_count(
+    source: &str,
+    ch: &mut Channel,
+    c: &Curve,
+    count: usize,
+    line: u64,
+    row_us: Option<f64>,
+    rows: &[u64],
+) -> Result<(), MeasuredError> {
+    let packed = count < rows.len()
+        && ch.lines.as_slice() == &rows[..count]
+        && c.cycle_us.zip(row_us).is_some_and(|(cy, r)| cy > 1.01 * r);
+    if let (true, Some(cycle), Some(&t0)) = (packed, c.cycle_us, ch.t_s.first()) {
+        for (i, t) in ch.t_s.iter_mut().enumerate() {
+            *t = t0 + i as f64 * cycle * 1e-6;
+        }
+        return Ok(());
+    }
+    if ch.t_s.len() == count {
+        return Ok(());
+    }
+    Err(MeasuredError::Trace {
+        at: Location::file_line(source, line),
+        message: format!(
+            "%COUNT={count} of channel '{}', but its column holds {} sample(s) (the file cut off, or edited?)",
+            quote_cell(&c.name),
+            ch.t_s.len()
+        ),
+    })
 }
 
 /// Keeps the first row of each run of `ratio` equal values (a channel held between its own
