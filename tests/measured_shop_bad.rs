@@ -157,8 +157,8 @@ fn every_spoiled_shop_folder_is_refused_in_one_line() {
                     .replace("internal = \"@\"", "internal = \"rtest/*.csv\""),
             )],
             vec![
-                format!("swapped/{r1}:1: missing column(s) t_s, x_int_mm, y_int_mm, z_int_mm"),
-                "(header read: 'R-Test logger export;test 01;".into(),
+                "swapped/rtest.toml: [[pairing]] #1 external: 'cnc/*.sco' matches ".into(),
+                format!("swapped/{t1}, a controller trace (the axes' own readings): traces belong to the internal pattern, the R-Test files to the external one (the patterns swapped?)"),
             ],
         ),
         (

@@ -102,14 +102,15 @@ fn a_test_written_differently_reads_alike() {
 }
 
 /// A Sinumerik trace declared ISO-8859-1, with a Latin-1 byte in its caption (as Operate
-/// writes them), gives the EIJ of the same trace in UTF-8.
+/// writes them), and one in UTF-16 with a byte-order mark give the EIJ of the same trace in
+/// UTF-8.
 #[test]
 fn a_latin1_sinumerik_trace_reads_alike() {
     let d = Scratch::new("trace-latin1");
     let files = shop::sinumerik_files(&root().join("measurements/demo-vmc/pos-a"));
     let (toml, xml, probe) = single(&files, "cnc/TRACE_01.xml", "cnc.xml");
     let xml = String::from_utf8(xml).unwrap();
-    let mut latin1 = xml
+    let latin1 = xml
         .replace("encoding=\"UTF-8\"", "encoding=\"ISO-8859-1\"")
         .replace("<traceData>", "<traceCaption>Kreis 2 mm, Vorschub 3 m/min, Ma\u{df}e in mm</traceCaption>\n  <traceData>")
         .chars()
@@ -117,16 +118,18 @@ fn a_latin1_sinumerik_trace_reads_alike() {
         .collect::<Vec<u8>>();
     assert!(std::str::from_utf8(&latin1).is_err());
     let mut eij = Vec::new();
+    let wide = utf16(&xml.replace("encoding=\"UTF-8\"", "encoding=\"UTF-16\""));
     for (folder, bytes) in [
         ("utf8", xml.into_bytes()),
-        ("latin1", std::mem::take(&mut latin1)),
+        ("latin1", latin1),
+        ("utf16", wide),
     ] {
         d.write(&format!("{folder}/rtest.toml"), &toml);
         d.write(&format!("{folder}/cnc.xml"), bytes);
         d.write(&format!("{folder}/probe.csv"), &probe);
         eij.push(eij_of(&d.path(folder)).unwrap_or_else(|e| panic!("{folder}: {e}")));
     }
-    assert!(eij[0] == eij[1]);
+    assert!(eij[0] == eij[1] && eij[0] == eij[2]);
 }
 
 /// A slower channel packed into the first rows of its column (`%COUNT=` rows at twice the row

@@ -163,6 +163,17 @@ fn stem(p: &Path) -> String {
         .unwrap_or_default()
 }
 
+/// Whether the file starts as a controller trace (TNCscope, Sinumerik XML) does.
+fn is_trace(f: &Path) -> bool {
+    use std::io::Read;
+    let mut head = Vec::new();
+    std::fs::File::open(f)
+        .and_then(|h| h.take(4096).read_to_end(&mut head))
+        .is_ok()
+        && super::traces::format_of(&super::series::utf8_of(head))
+            != super::traces::Format::Delimited
+}
+
 /// The internal and external files of one pairing matched (see the module docs).
 fn pair(
     p: &Pairing,
@@ -178,6 +189,16 @@ fn pair(
         }
         m
     };
+    if let Some(t) = external.iter().find(|f| is_trace(f)) {
+        return Err(bad(
+            "external",
+            format!(
+                "'{}' matches {}, a controller trace (the axes' own readings): traces belong to the internal pattern, the R-Test files to the external one (the patterns swapped?)",
+                quote_cell(&p.external),
+                t.display()
+            ),
+        ));
+    }
     let (int_stems, ext_stems) = (by_stem(internal), by_stem(external));
     let shared = int_stems.keys().any(|s| ext_stems.contains_key(s));
     if shared {
