@@ -28,6 +28,7 @@ mod hex8;
 pub mod mtx;
 mod reduce;
 mod sparse;
+mod warning;
 
 pub use attach::{Attachment, AttachmentKind, Station};
 pub use beam::Beam;
@@ -36,6 +37,7 @@ pub use reduce::{
     reduce, FeSummary, ReducedBody, ReductionSettings, StationSummary, CUTOFF_MARGIN,
 };
 pub use sparse::{free_free_frequencies_hz, lowest_modes, Modes};
+pub use warning::{Warning, FIRST_MODE_OFF};
 
 use faer::sparse::SparseColMat;
 use nalgebra::{Matrix3, Matrix6, Vector3};

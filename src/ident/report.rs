@@ -468,7 +468,7 @@ impl IdentReport {
             ),
             refusal: result.refusal.as_ref().map(|e| e.to_string()),
             warnings: result.warnings.iter().map(ToString::to_string).collect(),
-            notes: result.notes.clone(),
+            notes: result.notes.iter().map(ToString::to_string).collect(),
             rejected_steps: Some(result.rejected_steps),
             not_identifiable: result
                 .not_identifiable

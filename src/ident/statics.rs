@@ -91,7 +91,7 @@ pub struct StaticGroup {
     /// Whether reversal terms could be fitted (each direction at two or more accelerations).
     pub reversal_possible: bool,
     /// Why terms are not fitted, where they are not.
-    pub note: Option<String>,
+    pub note: Option<super::Note>,
 }
 
 impl StaticGroup {
@@ -145,11 +145,11 @@ fn distinct(values: impl Iterator<Item = f64>) -> usize {
     let mut v: Vec<f64> = values.collect();
     v.sort_by(f64::total_cmp);
     let mut count = 0;
-    let mut last = f64::NAN;
+    let mut last: Option<f64> = None;
     for x in v {
-        if !(x <= SAME_ACCEL_RATIO * last) {
+        if last.is_none_or(|l| x.is_nan() || x > SAME_ACCEL_RATIO * l) {
             count += 1;
-            last = x;
+            last = Some(x);
         }
     }
     count
@@ -210,10 +210,7 @@ impl Statics {
                 continue;
             }
             if all < 2 {
-                g.note = Some(format!(
-                    "static geometry not separable at {} (one acceleration): taken as part of the EIJ",
-                    g.label()
-                ));
+                g.note = Some(super::Note::StaticsNotSeparable { group: g.label() });
                 continue;
             }
             g.shared = true;
@@ -509,13 +506,12 @@ mod tests {
             .map(|d| (Plane::Xy, pos.clone(), 5.0, d))
             .to_vec();
         let s = Statics::new(&one, &rows_of(&one), StaticTerms::PerDirection, &[]);
-        assert!(
-            s.is_empty()
-                && s.groups[0]
-                    .note
-                    .as_deref()
-                    .unwrap()
-                    .contains("one acceleration")
+        assert!(s.is_empty());
+        assert_eq!(
+            s.groups[0].note,
+            Some(super::super::Note::StaticsNotSeparable {
+                group: s.groups[0].label()
+            })
         );
         let ccw: Vec<_> = [2.0, 8.0]
             .map(|a| (Plane::Xy, pos.clone(), a, Direction::Ccw))
