@@ -576,7 +576,7 @@ impl IdentReport {
     }
 
     /// The EIJ measured in at least one test, in parameter order.
-    pub fn eij_parameters(&self) -> Vec<Eij> {
+    pub(crate) fn eij_parameters(&self) -> Vec<Eij> {
         let mut all: Vec<Eij> = self
             .tests
             .iter()

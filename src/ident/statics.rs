@@ -364,7 +364,7 @@ impl Statics {
     }
 
     /// P·v: `v` without its part in A's column space.
-    pub fn project(&self, v: &DVector<f64>) -> DVector<f64> {
+    pub(crate) fn project(&self, v: &DVector<f64>) -> DVector<f64> {
         if self.basis.ncols() == 0 {
             return v.clone();
         }
@@ -372,7 +372,7 @@ impl Statics {
     }
 
     /// P·J, column by column.
-    pub fn project_matrix(&self, j: &DMatrix<f64>) -> DMatrix<f64> {
+    pub(crate) fn project_matrix(&self, j: &DMatrix<f64>) -> DMatrix<f64> {
         if self.basis.ncols() == 0 {
             return j.clone();
         }
@@ -381,7 +381,7 @@ impl Statics {
 
     /// χ² that the reversal terms of group `g` would remove from the projected residuals
     /// `r_p` (which are already orthogonal to A), and their number k.
-    pub fn reversal_gain(&self, g: usize, rows: &[Row], r_p: &DVector<f64>) -> (f64, usize) {
+    pub(crate) fn reversal_gain(&self, g: usize, rows: &[Row], r_p: &DVector<f64>) -> (f64, usize) {
         let group = &self.groups[g];
         let mut eijs: Vec<Eij> = rows
             .iter()

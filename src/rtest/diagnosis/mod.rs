@@ -227,7 +227,7 @@ impl SourceDiagnosis {
     }
 
     /// Mutable access to the term called `name`.
-    pub fn term_mut(&mut self, name: &str) -> Option<&mut Term> {
+    pub(crate) fn term_mut(&mut self, name: &str) -> Option<&mut Term> {
         self.terms.iter_mut().find(|t| t.name == name)
     }
 }
