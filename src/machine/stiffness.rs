@@ -203,7 +203,7 @@ pub struct StiffnessTable {
 
 /// The columns a table of a machine with elastic bodies adds (`factor_std_err` on identified
 /// tables only).
-pub const BODY_COLUMNS: [&str; 2] = ["first_frequency_hz", "factor_std_err"];
+pub(crate) const BODY_COLUMNS: [&str; 2] = ["first_frequency_hz", "factor_std_err"];
 
 /// The columns every stiffness table has (docs/stiffness-table.md).
 pub const COLUMNS: [&str; 7] = [
