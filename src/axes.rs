@@ -160,7 +160,7 @@ impl Direction {
     }
 
     /// The direction of a signed angular speed ω: ccw for ω > 0, else cw.
-    pub fn of_omega(omega_rad_s: f64) -> Direction {
+    pub(crate) fn of_omega(omega_rad_s: f64) -> Direction {
         if omega_rad_s > 0.0 {
             Direction::Ccw
         } else {
@@ -345,7 +345,7 @@ impl EijEstimates {
     }
 
     /// The standard errors alone.
-    pub fn std_err_map(&self) -> EijMap {
+    pub(crate) fn std_err_map(&self) -> EijMap {
         self.0.iter().map(|(p, e)| (*p, e.std_err)).collect()
     }
 }

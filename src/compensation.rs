@@ -258,7 +258,7 @@ impl CompensationTable {
 
     /// The correction of the set positions, m, at positions `pos_mm` (x, y, z) for set
     /// accelerations `acc_m_s2` (x, y, z): c_I = −Σ_J k_IJ(s_K)·a_J.
-    pub fn correction_m(&self, pos_mm: [f64; 3], acc_m_s2: [f64; 3]) -> [f64; 3] {
+    pub(crate) fn correction_m(&self, pos_mm: [f64; 3], acc_m_s2: [f64; 3]) -> [f64; 3] {
         let mut c = [0.0; 3];
         for k in &self.coefficients {
             c[k.parameter.deviation.index()] -=

@@ -25,12 +25,30 @@
 //!   alone; before `sim`, which hands its runs over as the evaluation's `CircleSeries`).
 //! * [`sim`]: set points (circle, jerk-limited move) and exact time-domain discretisation.
 //! * [`measured`]: what was measured, read from files (CSV layouts, `rtest.toml` conditions,
-//!   two-system recordings, EIJ tables and JSON, moves) and evaluated as one suite. A new file
-//!   format goes here; a new kind of body into [`machine`] and [`mbs`].
+//!   two-system recordings, EIJ tables and JSON, moves) and evaluated as one suite.
 //! * [`predict`]: simulated circle tests evaluated like measured ones: the EIJ a model predicts.
 //! * [`ident`]: stiffness reduction factors fitted to measured EIJ, with their uncertainty.
 //! * [`map`], [`compensation`]: EIJ over the workspace and compensation tables; `report`
 //!   (feature `report`): figures and the HTML report; the `eij` binary's `cli` last.
+//!
+//! ## Where new things go
+//!
+//! * **A new file format of measured data** goes into `src/measured`: a CSV dialect or column
+//!   map into `measured/layout.rs`, a controller's trace export as a file beside
+//!   `measured/traces/tnc.rs` and `sinumerik.rs` (recognised by content in
+//!   `measured/traces/mod.rs`), a table of EIJ into `measured/table.rs`. It reads into the
+//!   types [`rtest`] evaluates ([`CircleSeries`]), its errors are [`MeasuredError`] (one line
+//!   naming file, line or key), its keys and columns are described in
+//!   docs/measurement-files.md, and its tests are `tests/measured_*.rs` or `tests/traces_*.rs`.
+//!   The stages after `measured` see only what it reads, as from every other format.
+//! * **A new kind of body** (beside fixed, rigid and elastic) goes into `src/machine`: a
+//!   [`machine::BodyKind`] variant in `machine/body.rs` that answers the four questions every
+//!   body answers (its number of coordinates, how a point on it moves, its own mass, stiffness
+//!   and damping blocks, its rigid motion), its table in the machine file in `machine/raw.rs`,
+//!   checked once in `machine/validate.rs` (elastic bodies: `machine/elastic.rs`, with the
+//!   reduction in [`fe`]), described in docs/machine-file.md. [`mbs`] assembles a body only
+//!   through those four answers, so the assembly and every later stage take the new kind as it
+//!   is.
 //!
 //! Equation numbers (eq. 3–6, section 2.2/2.3) refer to the paper on acceleration correlated
 //! position errors measured with the R-Test that this tool implements and extends.

@@ -200,7 +200,7 @@ pub enum PredictError {
 
 impl PredictError {
     /// Index of the test whose conditions do not fit the machine, if that is the error.
-    pub fn test_index(&self) -> Option<usize> {
+    pub(crate) fn test_index(&self) -> Option<usize> {
         match self {
             PredictError::PositionLength { index, .. } | PredictError::Position { index, .. } => {
                 Some(*index)
@@ -305,7 +305,7 @@ impl Prediction {
 
     /// As [`Prediction::simulate`] with an explicit solver; in parallel over all (machine,
     /// centre) closed loops, then over all (machine, test) pairs.
-    pub fn simulate_with(
+    pub(crate) fn simulate_with(
         &self,
         machines: &[Machine],
         solver: SolverKind,

@@ -158,7 +158,12 @@ fn slow_circles_give_the_quasi_static_deflection_and_8_hz_circles_stay_within_2_
                 .iter()
                 .map(|&plane| CircleTest::new(plane, Direction::Ccw, 2.0, accel).at(p.to_vec()))
                 .collect();
-            let sim = simulated_eij(&[machine.clone()], &tests, &SimSettings::default()).unwrap();
+            let sim = simulated_eij(
+                std::slice::from_ref(&machine),
+                &tests,
+                &SimSettings::default(),
+            )
+            .unwrap();
             for (t, eij) in tests.iter().zip(&sim[0]) {
                 for e in t.plane.parameters() {
                     let (got, want) = (eij[&e], qs[&e]);

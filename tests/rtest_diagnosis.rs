@@ -464,8 +464,13 @@ fn several_accelerations_separate_geometry_from_eij() {
         .unwrap()
         .notes;
     assert!(
-        note.iter()
-            .any(|n| n.contains("grows with acceleration") && n.contains("EIJ")),
+        note.iter().any(|n| matches!(
+            n,
+            eij::rtest::diagnosis::Note::GrowsWithAcceleration {
+                source: Source::Structure,
+                ..
+            }
+        )),
         "{note:?}"
     );
 }

@@ -25,7 +25,7 @@ pub struct FeArgs {
 /// Relative differences of the reduced body's free-free frequencies from the full model's that
 /// the words name: 0.1 % (the issue's bar below half the cutoff) and 1 %.
 const CLOSE: f64 = 1e-3;
-const FAIR: f64 = 1e-2;
+const FAIR: f64 = eij::fe::FIRST_MODE_OFF;
 
 /// Runs `eij fe`.
 pub fn run(args: FeArgs) -> anyhow::Result<()> {
@@ -65,7 +65,7 @@ pub fn run(args: FeArgs) -> anyhow::Result<()> {
             args.machine.display()
         );
     };
-    let warnings = warnings(&summary);
+    let warnings = summary.warnings();
     for w in &warnings {
         errln!("eij: warning: {w}");
     }
@@ -109,22 +109,6 @@ fn percent(d: f64) -> f64 {
 /// How many of the lowest modes lie within `tol` of the full model's.
 fn lowest_within(d: &[f64], tol: f64) -> usize {
     d.iter().take_while(|x| x.abs() <= tol).count()
-}
-
-/// Doubts about the reduction, said on standard error and in the JSON.
-fn warnings(s: &FeSummary) -> Vec<String> {
-    let d = differences(s);
-    match d.first() {
-        Some(first) if first.abs() > FAIR => vec![format!(
-            "body {}: the reduced body's first free-free mode ({:.2} Hz) is {:+.2} % off the full model's ({:.2} Hz): \
-             the reduction does not resolve the body; keep more modes (`modes` or `cutoff_hz`)",
-            s.body,
-            s.free_frequencies_hz[0],
-            100.0 * first,
-            s.full_free_frequencies_hz[0]
-        )],
-        _ => Vec::new(),
-    }
 }
 
 /// The summary for reading, with the resolution in words.

@@ -188,8 +188,10 @@ pub(super) fn prepare(
     cli_params: &[String],
     design: bool,
 ) -> anyhow::Result<Prepared> {
-    let mut settings = Settings::default();
-    settings.design = design;
+    let mut settings = Settings {
+        design,
+        ..Default::default()
+    };
     let mut mopts = MeasuredOptions::default();
     config.apply(&mut settings, &mut mopts)?;
     let names: Vec<String> = if !cli_params.is_empty() {

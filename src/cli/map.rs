@@ -75,12 +75,7 @@ pub fn run(args: MapArgs) -> anyhow::Result<()> {
     drop(bar);
     let axes: Vec<_> = machine.axes().iter().map(|a| a.axis).collect();
     let svg = match &args.plot {
-        Some(_) => Some(eij::report::map_svg(
-            &machine.name(),
-            &axes,
-            &spec,
-            &points,
-        )?),
+        Some(_) => Some(eij::report::map_svg(machine.name(), &axes, &spec, &points)?),
         None => None,
     };
     let csv = to_csv(&machine, &spec, &points);

@@ -363,7 +363,7 @@ impl ClosedLoop {
     ///
     /// Undamped structural modes that the drives do not touch stay on the imaginary axis
     /// (Re λ = 0 up to round-off, |Re λ| ≤ 1e-9·|λ|); they are marginally stable and accepted.
-    pub fn check_stability(&self, machine: &Machine) -> Result<(), ControlError> {
+    pub(crate) fn check_stability(&self, machine: &Machine) -> Result<(), ControlError> {
         let n = self.a.nrows();
         let unstable = |re: f64, im: f64| re > 1e-9 * (re * re + im * im).sqrt();
         // Eigenvalues alone decide; eigenvectors are computed only to name the axis.

@@ -45,7 +45,7 @@ impl Certificate {
         let eig = b.eigen().ok()?;
         let v = eig.U().to_owned();
         let lambda: Vec<c64> = (0..n).map(|k| eig.S()[k]).collect();
-        if lambda.iter().any(|l| !(l.re < 0.0)) {
+        if lambda.iter().any(|l| l.re.is_nan() || l.re >= 0.0) {
             return None;
         }
         let w = v.adjoint() * &v;

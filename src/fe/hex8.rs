@@ -89,7 +89,7 @@ fn brick(h: [f64; 3], e: f64, nu: f64, rho: f64) -> (M24, M24) {
 
 impl Hex8Block {
     /// Number of nodes along x, y, z.
-    pub fn node_counts(&self) -> [usize; 3] {
+    pub(crate) fn node_counts(&self) -> [usize; 3] {
         self.divisions.map(|d| d + 1)
     }
 

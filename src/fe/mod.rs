@@ -28,6 +28,7 @@ mod hex8;
 pub mod mtx;
 mod reduce;
 mod sparse;
+mod warning;
 
 pub use attach::{Attachment, AttachmentKind, Station};
 pub use beam::Beam;
@@ -36,6 +37,7 @@ pub use reduce::{
     reduce, FeSummary, ReducedBody, ReductionSettings, StationSummary, CUTOFF_MARGIN,
 };
 pub use sparse::{free_free_frequencies_hz, lowest_modes, Modes};
+pub use warning::{Warning, FIRST_MODE_OFF};
 
 use faer::sparse::SparseColMat;
 use nalgebra::{Matrix3, Matrix6, Vector3};
@@ -253,7 +255,7 @@ impl FeModel {
     }
 
     /// True where node `i` carries rotations (beam and shell nodes).
-    pub fn has_rotations(&self, i: usize) -> bool {
+    pub(crate) fn has_rotations(&self, i: usize) -> bool {
         self.node_dofs[i][3].is_some()
     }
 
@@ -271,7 +273,7 @@ impl FeModel {
     }
 
     /// Diagonal of the box around the nodes, m: the body's extent.
-    pub fn extent_m(&self) -> f64 {
+    pub(crate) fn extent_m(&self) -> f64 {
         let (lo, hi) = self.bounds();
         (hi - lo).norm()
     }
@@ -279,7 +281,7 @@ impl FeModel {
     /// Rigid-body motions of the model as six columns (translation x, y, z and rotation a, b, c
     /// about `centre`): a node at x moves by t + θ × (x − centre) and turns by θ. Stored as
     /// n × 6, column-major.
-    pub fn rigid_modes(&self, centre: &Vector3<f64>) -> faer::Mat<f64> {
+    pub(crate) fn rigid_modes(&self, centre: &Vector3<f64>) -> faer::Mat<f64> {
         let mut r = faer::Mat::zeros(self.n_dofs(), 6);
         for (row, &(i, kind)) in self.dofs.iter().enumerate() {
             let d = self.nodes[i].position - centre;

@@ -31,7 +31,7 @@ use super::{identify, IdentError, IdentResult, Problem};
 use rayon::prelude::*;
 
 /// ΔBIC below which the data do not tell two candidates apart.
-pub const INDISTINCT_DELTA_BIC: f64 = 2.0;
+pub(crate) const INDISTINCT_DELTA_BIC: f64 = 2.0;
 
 /// A group reproduced within this RMS z counts as reproduced in the verdict's words.
 const REPRODUCED_RMS_Z: f64 = 2.0;

@@ -56,7 +56,7 @@ pub struct Design {
     /// Candidates evaluated.
     pub evaluated: usize,
     /// Remarks (candidates left out, how new positions count).
-    pub notes: Vec<String>,
+    pub notes: Vec<super::Note>,
 }
 
 impl Design {
@@ -188,7 +188,7 @@ pub fn rank(
     let sims = match sims {
         Ok(s) => s,
         Err(e) => {
-            notes.push(format!("candidate tests could not be simulated: {e}"));
+            notes.push(super::Note::CandidatesNotSimulated(e));
             return Ok(Design {
                 parameters: names,
                 rel_std_err_now,
@@ -289,10 +289,7 @@ pub fn rank(
     ranked.sort_by(|a, b| a.worst_rel_std_err.total_cmp(&b.worst_rel_std_err));
     let evaluated = ranked.len();
     ranked.truncate(KEEP);
-    notes.push(
-        "a candidate at a new circle-centre position counts as one test there: its static geometry would be taken as part of its EIJ; measure it at two accelerations to separate it"
-            .into(),
-    );
+    notes.push(super::Note::NewPositionCountsOnce);
     Ok(Design {
         parameters: names,
         rel_std_err_now,

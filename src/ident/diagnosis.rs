@@ -90,7 +90,7 @@ pub(crate) fn static_groups(result: &IdentResult) -> Vec<StaticGroupReport> {
                 tests: group.tests.len(),
                 shared: group.shared,
                 reversal: group.reversal,
-                note: group.note.clone(),
+                note: group.note.as_ref().map(ToString::to_string),
                 geometric_um_per_mm: BTreeMap::new(),
                 geometric_std_err_um_per_mm: BTreeMap::new(),
                 reversal_um_per_mm: BTreeMap::new(),
@@ -188,7 +188,7 @@ impl From<&Design> for DesignReport {
                     rel_std_err: by_name(&c.rel_std_err),
                 })
                 .collect(),
-            notes: d.notes.clone(),
+            notes: d.notes.iter().map(ToString::to_string).collect(),
         }
     }
 }

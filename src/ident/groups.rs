@@ -55,7 +55,7 @@ impl GroupFit {
 }
 
 /// The set acceleration as written in labels: `5`, `2.5`.
-pub fn short_accel(accel_m_s2: f64) -> String {
+pub(crate) fn short_accel(accel_m_s2: f64) -> String {
     let s = format!("{accel_m_s2:.2}");
     s.trim_end_matches('0').trim_end_matches('.').to_string()
 }

@@ -74,7 +74,7 @@ pub fn centres(problem: &Problem) -> Vec<(Vec<f64>, Vec<usize>)> {
 
 /// Leave one circle centre out (see the module docs); `None` when the tests hold fewer than two
 /// centres. The folds are fitted in parallel without the ranking of candidate tests.
-pub fn leave_one_centre_out(problem: &Problem) -> Option<CentreHoldOut> {
+pub(crate) fn leave_one_centre_out(problem: &Problem) -> Option<CentreHoldOut> {
     let centres = centres(problem);
     if centres.len() < 2 {
         return None;

@@ -145,8 +145,8 @@ pub(crate) fn analyse(j: &DMatrix<f64>, theta: &DVector<f64>) -> Analysis {
     let max_norm = norms.iter().cloned().fold(0.0, f64::max);
     let mut not_identifiable = Vec::new();
     let mut free: Vec<usize> = Vec::new();
-    for i in 0..n {
-        if norms[i] > UNIDENTIFIABLE_COLUMN * max_norm && norms[i] > 1e-12 {
+    for (i, &norm) in norms.iter().enumerate() {
+        if norm > UNIDENTIFIABLE_COLUMN * max_norm && norm > 1e-12 {
             free.push(i);
         } else {
             not_identifiable.push(NotIdentifiable {

@@ -47,6 +47,7 @@ pub(crate) mod identifiability;
 pub(crate) mod lm;
 pub mod measured;
 pub mod mismatch;
+mod note;
 pub(crate) mod parameters;
 pub(crate) mod problem;
 pub mod report;
@@ -64,6 +65,7 @@ pub use crate::predict::{EijMap, SolverKind};
 pub use builder::Identification;
 pub use error::IdentError;
 pub use identifiability::NotIdentifiable;
+pub use note::Note;
 pub use parameters::{Parameter, ParameterKind};
 pub use problem::{Problem, TestCase};
 pub use settings::{MeasuredOptions, Method, Settings};
@@ -173,7 +175,7 @@ pub struct IdentResult {
     /// Warnings (non-identifiable parameters, bounds, χ², plausibility, model mismatch).
     pub warnings: Vec<Warning>,
     /// Notes (static terms not separable, reversal terms added).
-    pub notes: Vec<String>,
+    pub notes: Vec<Note>,
     /// Why the fit must not be exported: it did not converge or ended on a bound.
     pub refusal: Option<IdentError>,
     /// The identified machine.
@@ -216,7 +218,7 @@ pub fn identify(
     let (j0, r0) = problem.jacobian_at(&theta0)?;
     let mut analysis = identifiability::analyse(&j0, &theta0);
     acceptance::check_start(problem, &analysis, &theta0, &names, r0.len())?;
-    let mut notes: Vec<String> = problem
+    let mut notes: Vec<Note> = problem
         .statics()
         .groups
         .iter()
@@ -297,9 +299,9 @@ pub fn identify(
     };
     let rejected_steps = problem.unsimulable();
     if rejected_steps > 0 {
-        notes.push(format!(
-            "{rejected_steps} trial step(s) could not be simulated (e.g. an unstable closed loop) and were rejected"
-        ));
+        notes.push(Note::RejectedSteps {
+            count: rejected_steps,
+        });
     }
     let cost_history = costs.lock().map(|c| c.clone()).unwrap_or_default();
     Ok(IdentResult {

@@ -126,7 +126,7 @@ impl Parameter {
     }
 
     /// Index of its body in [`Machine::bodies`] (`Some` for a body's stiffness only).
-    pub fn body_index(&self) -> Option<usize> {
+    pub(crate) fn body_index(&self) -> Option<usize> {
         (self.kind == ParameterKind::BodyStiffness).then_some(self.index)
     }
 

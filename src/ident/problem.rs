@@ -175,7 +175,7 @@ impl Problem {
 
     /// The static terms of the settings' mode, with reversal terms forced for the groups
     /// `reversal` (indices into [`Statics::groups`]).
-    pub fn statics_with(&self, reversal: &[usize]) -> Statics {
+    pub(crate) fn statics_with(&self, reversal: &[usize]) -> Statics {
         let tests: Vec<_> = self
             .tests
             .iter()
@@ -211,7 +211,7 @@ impl Problem {
     }
 
     /// The same problem with other static terms.
-    pub fn with_statics(&self, statics: Statics) -> Problem {
+    pub(crate) fn with_statics(&self, statics: Statics) -> Problem {
         let mut p = self.clone();
         p.statics = statics;
         p
@@ -264,7 +264,7 @@ impl Problem {
 
     /// Trial points so far that could not be simulated (unstable closed loop, resonance) and
     /// were rejected as steps.
-    pub fn unsimulable(&self) -> u64 {
+    pub(crate) fn unsimulable(&self) -> u64 {
         self.unsimulable.load(Ordering::Relaxed)
     }
 
@@ -303,7 +303,10 @@ impl Problem {
 
     /// As [`Problem::simulate_many`], with a result per parameter vector: one that cannot be
     /// simulated does not spoil the others.
-    pub fn simulate_each(&self, thetas: &[DVector<f64>]) -> Vec<Result<Vec<EijMap>, IdentError>> {
+    pub(crate) fn simulate_each(
+        &self,
+        thetas: &[DVector<f64>],
+    ) -> Vec<Result<Vec<EijMap>, IdentError>> {
         match self.simulate_many(thetas) {
             Ok(all) => all.into_iter().map(Ok).collect(),
             Err(_) => thetas
@@ -319,7 +322,7 @@ impl Problem {
     /// As [`Problem::simulate_many`] with an explicit solver. Parameter sets simulated
     /// recently (the centre and neighbours of a Jacobian, an accepted step) are taken from a
     /// cache and not simulated again; [`Problem::evaluations`] counts the ones simulated.
-    pub fn simulate_many_with(
+    pub(crate) fn simulate_many_with(
         &self,
         thetas: &[DVector<f64>],
         solver: SolverKind,
@@ -378,7 +381,7 @@ impl Problem {
 
     /// Weighted errors (E_sim − E_meas)/σ in the order of [`Problem::rows`] (tests, then
     /// parameters by name), before the static terms are eliminated.
-    pub fn errors_of(&self, sims: &[EijMap]) -> DVector<f64> {
+    pub(crate) fn errors_of(&self, sims: &[EijMap]) -> DVector<f64> {
         DVector::from_iterator(
             self.rows.len(),
             self.rows.iter().map(|row| {
@@ -410,19 +413,19 @@ impl Problem {
     }
 
     /// Residuals r = P·(E_sim − E_meas)/σ: the weighted errors without the static terms.
-    pub fn residuals_of(&self, sims: &[EijMap]) -> DVector<f64> {
+    pub(crate) fn residuals_of(&self, sims: &[EijMap]) -> DVector<f64> {
         self.statics.project(&self.errors_of(sims))
     }
 
     /// Residuals at θ.
-    pub fn residuals_at(&self, theta: &DVector<f64>) -> Result<DVector<f64>, IdentError> {
+    pub(crate) fn residuals_at(&self, theta: &DVector<f64>) -> Result<DVector<f64>, IdentError> {
         let sims = self.simulate_many(std::slice::from_ref(theta))?;
         Ok(self.residuals_of(&sims[0]))
     }
 
     /// Jacobian of the residuals and the residuals at θ (see [`Problem::error_jacobian_at`]):
     /// the projection is linear and does not depend on θ, so P·J is exact.
-    pub fn jacobian_at(
+    pub(crate) fn jacobian_at(
         &self,
         theta: &DVector<f64>,
     ) -> Result<(DMatrix<f64>, DVector<f64>), IdentError> {

@@ -468,7 +468,7 @@ impl IdentReport {
             ),
             refusal: result.refusal.as_ref().map(|e| e.to_string()),
             warnings: result.warnings.iter().map(ToString::to_string).collect(),
-            notes: result.notes.clone(),
+            notes: result.notes.iter().map(ToString::to_string).collect(),
             rejected_steps: Some(result.rejected_steps),
             not_identifiable: result
                 .not_identifiable
@@ -576,7 +576,7 @@ impl IdentReport {
     }
 
     /// The EIJ measured in at least one test, in parameter order.
-    pub fn eij_parameters(&self) -> Vec<Eij> {
+    pub(crate) fn eij_parameters(&self) -> Vec<Eij> {
         let mut all: Vec<Eij> = self
             .tests
             .iter()

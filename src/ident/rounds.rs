@@ -6,7 +6,7 @@
 use super::identifiability::{self, Analysis};
 use super::problem::Reduced;
 use super::settings::CHI2_SIGMAS;
-use super::{solve, IdentError, Problem, ProgressFn, StaticTerms};
+use super::{solve, IdentError, Note, Problem, ProgressFn, StaticTerms};
 use nalgebra::{DMatrix, DVector};
 use std::borrow::Cow;
 use std::sync::{Arc, Mutex};
@@ -39,7 +39,7 @@ pub(super) fn fit_in_rounds<'a>(
     analysis: &mut Analysis,
     theta0: &DVector<f64>,
     names: &[String],
-    notes: &mut Vec<String>,
+    notes: &mut Vec<Note>,
     costs: Arc<Mutex<Vec<f64>>>,
     progress: Option<Arc<ProgressFn>>,
 ) -> Result<Rounds<'a>, IdentError> {
@@ -58,10 +58,9 @@ pub(super) fn fit_in_rounds<'a>(
             if !need.is_empty() {
                 let with = current.with_statics(current.statics_with(&need));
                 for &g in &need {
-                    notes.push(format!(
-                        "reversal terms (static, sign flipping with the direction) fitted at {}: the data need them",
-                        with.statics().groups[g].label()
-                    ));
+                    notes.push(Note::ReversalTermsFitted {
+                        group: with.statics().groups[g].label(),
+                    });
                 }
                 current = Cow::Owned(with);
                 continue;
@@ -75,8 +74,7 @@ pub(super) fn fit_in_rounds<'a>(
                 &current,
                 &e_jac,
                 &mut theta,
-                theta0,
-                names,
+                Start { theta0, names },
                 notes,
             );
         if settled {
@@ -149,6 +147,12 @@ fn reversal_needed(
         .collect())
 }
 
+/// The start of the rounds: θ₀ of all parameters and their names.
+struct Start<'s> {
+    theta0: &'s DVector<f64>,
+    names: &'s [String],
+}
+
 /// Re-checks identifiability at the solution θ (the operating point matters: a compliance
 /// weakly seen from the catalogue values may be determined at the solution, or the reverse)
 /// with the Jacobian of the weighted errors `e_jac`, over all parameters. Returns true when the
@@ -162,9 +166,8 @@ fn rounds_left(
     problem: &Problem,
     e_jac: &DMatrix<f64>,
     theta: &mut DVector<f64>,
-    theta0: &DVector<f64>,
-    names: &[String],
-    notes: &mut Vec<String>,
+    Start { theta0, names }: Start<'_>,
+    notes: &mut Vec<Note>,
 ) -> bool {
     if history.len() > MAX_ROUNDS || history.last() != Some(&analysis.free) {
         return true;
@@ -202,12 +205,7 @@ fn rounds_left(
     if again.free.is_empty() {
         return true;
     }
-    let list = |v: Vec<usize>| -> String {
-        v.into_iter()
-            .map(|i| names[i].clone())
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
+    let list = |v: Vec<usize>| -> Vec<String> { v.into_iter().map(|i| names[i].clone()).collect() };
     let released: Vec<usize> = again
         .free
         .iter()
@@ -223,22 +221,10 @@ fn rounds_left(
     for &i in &held {
         theta[i] = theta0[i];
     }
-    notes.push(format!(
-        "identifiability at the solution differs from that at the start values{}{}: fitted again",
-        if released.is_empty() {
-            String::new()
-        } else {
-            format!("; determined now: {}", list(released))
-        },
-        if held.is_empty() {
-            String::new()
-        } else {
-            format!(
-                "; not determined now (back to the start value): {}",
-                list(held)
-            )
-        },
-    ));
+    notes.push(Note::IdentifiabilityChanged {
+        determined: list(released),
+        not_determined: list(held),
+    });
     *analysis = again;
     false
 }

@@ -81,7 +81,7 @@ impl Default for Settings {
 
 impl Settings {
     /// Bounds of θ = 1/p.
-    pub fn theta_bounds(&self) -> (f64, f64) {
+    pub(crate) fn theta_bounds(&self) -> (f64, f64) {
         (1.0 / self.max_factor, 1.0 / self.min_factor)
     }
 

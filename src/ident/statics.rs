@@ -91,7 +91,7 @@ pub struct StaticGroup {
     /// Whether reversal terms could be fitted (each direction at two or more accelerations).
     pub reversal_possible: bool,
     /// Why terms are not fitted, where they are not.
-    pub note: Option<String>,
+    pub note: Option<super::Note>,
 }
 
 impl StaticGroup {
@@ -145,11 +145,11 @@ fn distinct(values: impl Iterator<Item = f64>) -> usize {
     let mut v: Vec<f64> = values.collect();
     v.sort_by(f64::total_cmp);
     let mut count = 0;
-    let mut last = f64::NAN;
+    let mut last: Option<f64> = None;
     for x in v {
-        if !(x <= SAME_ACCEL_RATIO * last) {
+        if last.is_none_or(|l| x.is_nan() || x > SAME_ACCEL_RATIO * l) {
             count += 1;
-            last = x;
+            last = Some(x);
         }
     }
     count
@@ -210,10 +210,7 @@ impl Statics {
                 continue;
             }
             if all < 2 {
-                g.note = Some(format!(
-                    "static geometry not separable at {} (one acceleration): taken as part of the EIJ",
-                    g.label()
-                ));
+                g.note = Some(super::Note::StaticsNotSeparable { group: g.label() });
                 continue;
             }
             g.shared = true;
@@ -367,7 +364,7 @@ impl Statics {
     }
 
     /// P·v: `v` without its part in A's column space.
-    pub fn project(&self, v: &DVector<f64>) -> DVector<f64> {
+    pub(crate) fn project(&self, v: &DVector<f64>) -> DVector<f64> {
         if self.basis.ncols() == 0 {
             return v.clone();
         }
@@ -375,7 +372,7 @@ impl Statics {
     }
 
     /// P·J, column by column.
-    pub fn project_matrix(&self, j: &DMatrix<f64>) -> DMatrix<f64> {
+    pub(crate) fn project_matrix(&self, j: &DMatrix<f64>) -> DMatrix<f64> {
         if self.basis.ncols() == 0 {
             return j.clone();
         }
@@ -384,7 +381,7 @@ impl Statics {
 
     /// χ² that the reversal terms of group `g` would remove from the projected residuals
     /// `r_p` (which are already orthogonal to A), and their number k.
-    pub fn reversal_gain(&self, g: usize, rows: &[Row], r_p: &DVector<f64>) -> (f64, usize) {
+    pub(crate) fn reversal_gain(&self, g: usize, rows: &[Row], r_p: &DVector<f64>) -> (f64, usize) {
         let group = &self.groups[g];
         let mut eijs: Vec<Eij> = rows
             .iter()
@@ -509,13 +506,12 @@ mod tests {
             .map(|d| (Plane::Xy, pos.clone(), 5.0, d))
             .to_vec();
         let s = Statics::new(&one, &rows_of(&one), StaticTerms::PerDirection, &[]);
-        assert!(
-            s.is_empty()
-                && s.groups[0]
-                    .note
-                    .as_deref()
-                    .unwrap()
-                    .contains("one acceleration")
+        assert!(s.is_empty());
+        assert_eq!(
+            s.groups[0].note,
+            Some(super::super::Note::StaticsNotSeparable {
+                group: s.groups[0].label()
+            })
         );
         let ccw: Vec<_> = [2.0, 8.0]
             .map(|a| (Plane::Xy, pos.clone(), a, Direction::Ccw))

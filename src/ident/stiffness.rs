@@ -3,7 +3,9 @@
 //! `[provenance]` an identified machine file carries — so that `eij stiffness` of the exported
 //! file gives exactly the table `eij identify --stiffness-out` wrote.
 
-use super::{IdentResult, Parameter, ParameterKind, Problem};
+use std::fmt;
+
+use super::{IdentError, IdentResult, Parameter, ParameterKind, Problem};
 use crate::machine::stiffness::{FactorKind, StiffnessTable};
 use crate::machine::Machine;
 
@@ -55,10 +57,55 @@ pub fn identified_table(problem: &Problem, result: &IdentResult) -> StiffnessTab
     )
 }
 
+/// A recorded factor of a machine file's `[provenance]` that no longer holds: its standard
+/// error is left out of the table. Rendered to text where it is shown, as [`super::Warning`].
+#[derive(Debug, Clone, PartialEq)]
+pub enum ProvenanceWarning {
+    /// A recorded parameter that does not name a parameter of the machine.
+    Unknown {
+        /// The machine file.
+        file: String,
+        /// Why it names none.
+        error: IdentError,
+    },
+    /// A recorded factor the file no longer has: it was edited after the identification.
+    Edited {
+        /// The machine file.
+        file: String,
+        /// The parameter.
+        parameter: String,
+        /// Its factor in the file now.
+        now: f64,
+        /// The factor identified, as recorded.
+        identified: f64,
+    },
+}
+
+impl fmt::Display for ProvenanceWarning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ProvenanceWarning::Unknown { file, error } => write!(
+                f,
+                "{file}: provenance: {error}; its standard error is left out"
+            ),
+            ProvenanceWarning::Edited {
+                file,
+                parameter,
+                now,
+                identified,
+            } => write!(
+                f,
+                "{file}: {parameter} = {now} differs from the identified {identified} recorded in \
+                 [provenance]: its standard error is left out"
+            ),
+        }
+    }
+}
+
 /// The stiffness table of a machine file: with the standard errors its `[provenance]` records
 /// when it is an identified file, and warnings for recorded factors that no longer hold (the
 /// file was edited after the identification; their standard errors are left out).
-pub fn machine_table(machine: &Machine) -> (StiffnessTable, Vec<String>) {
+pub fn machine_table(machine: &Machine) -> (StiffnessTable, Vec<ProvenanceWarning>) {
     let Some(provenance) = machine.to_raw().provenance else {
         return (StiffnessTable::of(machine), Vec::new());
     };
@@ -67,20 +114,22 @@ pub fn machine_table(machine: &Machine) -> (StiffnessTable, Vec<String>) {
     for (name, recorded) in &provenance.parameters {
         let parameter = match Parameter::parse(name, machine) {
             Ok(p) => p,
-            Err(e) => {
-                warnings.push(format!(
-                    "{}: provenance: {e}; its standard error is left out",
-                    machine.source()
-                ));
+            Err(error) => {
+                warnings.push(ProvenanceWarning::Unknown {
+                    file: machine.source().to_string(),
+                    error,
+                });
                 continue;
             }
         };
         let now = parameter.get(machine);
         if recorded.identified != now {
-            warnings.push(format!(
-                "{}: {name} = {now} differs from the identified {} recorded in [provenance]: its standard error is left out",
-                machine.source(), recorded.identified
-            ));
+            warnings.push(ProvenanceWarning::Edited {
+                file: machine.source().to_string(),
+                parameter: name.clone(),
+                now,
+                identified: recorded.identified,
+            });
             continue;
         }
         fitted.push((parameter, recorded.std_err));
@@ -173,5 +222,20 @@ mod tests {
                 _ => assert_eq!((&r.std_err_n_per_um, &r.parameter), (&None, &None)),
             }
         }
+    }
+
+    #[test]
+    fn an_edited_factor_is_said_with_both_values() {
+        let w = ProvenanceWarning::Edited {
+            file: "machines/vmc-identified.toml".into(),
+            parameter: "y.screw".into(),
+            now: 0.5,
+            identified: 0.8125,
+        };
+        assert_eq!(
+            w.to_string(),
+            "machines/vmc-identified.toml: y.screw = 0.5 differs from the identified 0.8125 \
+             recorded in [provenance]: its standard error is left out"
+        );
     }
 }

@@ -152,7 +152,11 @@ impl Machine {
 
     /// Sets the factor on the elastic stiffness of body `body` (finite and > 0; the body must
     /// be elastic).
-    pub fn set_body_stiffness(&mut self, body: usize, value: f64) -> Result<(), MachineError> {
+    pub(crate) fn set_body_stiffness(
+        &mut self,
+        body: usize,
+        value: f64,
+    ) -> Result<(), MachineError> {
         let source = self.source.clone();
         let b = self
             .bodies

@@ -295,7 +295,7 @@ impl Body {
     }
 
     /// Coordinate names without the body's name: `x` … `c`, then `mode1` … `mode<m>`.
-    pub fn coordinate_names(&self) -> Vec<String> {
+    pub(crate) fn coordinate_names(&self) -> Vec<String> {
         let w = self.width();
         (0..w)
             .map(|i| match RIGID_COORDINATES.get(i) {

@@ -49,7 +49,7 @@ impl Catalogue {
     }
 
     /// Adds the entries of a catalogue file's text; `file` names it in errors.
-    pub fn add_toml(&mut self, text: &str, file: &str) -> Result<(), MachineError> {
+    pub(crate) fn add_toml(&mut self, text: &str, file: &str) -> Result<(), MachineError> {
         let raw: RawCatalogue =
             toml::from_str(text).map_err(|e| MachineError::toml(file, text, &e))?;
         for (i, c) in raw.carriages.into_iter().enumerate() {

@@ -84,7 +84,7 @@ impl FeBody {
 
     /// Per attachment of the reduction, its position at the machine's reference position
     /// (metres along the travel; 0 for a fixed point), for `eij fe`'s summary.
-    pub fn reference_positions(&self) -> Vec<f64> {
+    pub(crate) fn reference_positions(&self) -> Vec<f64> {
         let mut s = vec![0.0; self.reduction.reduced.attachments.len()];
         for (_, r) in &self.reach {
             if let Reach::Travel {
@@ -248,7 +248,7 @@ impl From<&RawBeam> for Beam {
 impl Machine {
     /// The name of a site in `eij fe`'s attachments: `z.carriage[0]`, `z.nut`, `z.scale`,
     /// `joint[foot-front-left]`, `tcp`, `workpiece`.
-    pub fn site_label(&self, site: Site) -> String {
+    pub(crate) fn site_label(&self, site: Site) -> String {
         match site {
             Site::Joint(j) => format!("joint[{}]", self.joints[j].name),
             other => other.to_string(),

@@ -318,11 +318,6 @@ impl Machine {
         &self.joints
     }
 
-    /// For each body, the axis that moves it (it is that axis's moving body), if any.
-    pub fn moved_by(&self) -> &[Option<usize>] {
-        &self.moved_by
-    }
-
     /// Sets a reduction factor of axis `axis_index` (finite and > 0, else an error naming the key).
     pub fn set_reduction(
         &mut self,
@@ -437,7 +432,7 @@ impl Machine {
     }
 
     /// Total mass carried by an axis (its moving body and every body it carries), kg.
-    pub fn moved_mass_kg(&self, axis_index: usize) -> f64 {
+    pub(crate) fn moved_mass_kg(&self, axis_index: usize) -> f64 {
         (0..self.bodies.len())
             .filter(|&b| self.is_carried_by(b, axis_index))
             .map(|b| self.bodies[b].mass_kg)

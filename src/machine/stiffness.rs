@@ -158,7 +158,7 @@ pub struct StiffnessRow {
 
 impl StiffnessRow {
     /// The reduction factor that scales this row.
-    pub fn factor_kind(&self) -> FactorKind {
+    pub(crate) fn factor_kind(&self) -> FactorKind {
         match (self.element, self.direction) {
             (Element::Guideway, StiffnessDirection::Lateral) => FactorKind::GuidewayLateral,
             (Element::Guideway, _) => FactorKind::GuidewayNormal,
@@ -203,7 +203,7 @@ pub struct StiffnessTable {
 
 /// The columns a table of a machine with elastic bodies adds (`factor_std_err` on identified
 /// tables only).
-pub const BODY_COLUMNS: [&str; 2] = ["first_frequency_hz", "factor_std_err"];
+pub(crate) const BODY_COLUMNS: [&str; 2] = ["first_frequency_hz", "factor_std_err"];
 
 /// The columns every stiffness table has (docs/stiffness-table.md).
 pub const COLUMNS: [&str; 7] = [
@@ -349,7 +349,7 @@ impl StiffnessTable {
 
     /// Marks the table as identified and gives the row of elastic body `body` the parameter
     /// that set its factor and the factor's standard error.
-    pub fn set_body_std_err(&mut self, body: &str, parameter: &str, std_err: Option<f64>) {
+    pub(crate) fn set_body_std_err(&mut self, body: &str, parameter: &str, std_err: Option<f64>) {
         self.identified = true;
         for r in self.bodies.iter_mut().filter(|r| r.body == body) {
             r.factor_std_err = std_err;

@@ -275,8 +275,8 @@ fn mean_square(
     for i in (0..internal.t_s.len()).step_by(stride) {
         let t = internal.t_s[i];
         if let Some(e) = external.sample(t - offset_s, &mut hint) {
-            for c in 0..3 {
-                let d = (e[c] - internal.mm[c][i]) * 1e3;
+            for (e_c, mm_c) in e.iter().zip(&internal.mm) {
+                let d = (e_c - mm_c[i]) * 1e3;
                 sum += d * d;
             }
             count += 1;

@@ -33,7 +33,7 @@ impl Location {
     }
 
     /// A line of a file.
-    pub fn file_line(source: &str, line: u64) -> Self {
+    pub(crate) fn file_line(source: &str, line: u64) -> Self {
         Location {
             source: source.to_string(),
             line: Some(Line::File(line)),

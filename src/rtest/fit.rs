@@ -102,7 +102,7 @@ impl Ellipse {
     /// Half-widths of the ellipse along a and b, in units of r: √((Q'⁻¹)_aa), √((Q'⁻¹)_bb).
     /// For the image (I − ε)·u of the unit circle, Q'⁻¹ = (I − ε)(I − ε)ᵀ, so the half-width
     /// along a is √((1 − ε_aa)² + ε_ab²).
-    pub fn half_widths(&self) -> Option<[f64; 2]> {
+    pub(crate) fn half_widths(&self) -> Option<[f64; 2]> {
         let s = self.q.try_inverse()?;
         Some([s[(0, 0)].sqrt(), s[(1, 1)].sqrt()])
     }

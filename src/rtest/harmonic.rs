@@ -162,7 +162,7 @@ pub fn joint_eij(
     let scale = -radius_mm * 1e-3 * omega_hat * omega_hat;
     let (cc, ss, cs) = (0.5 * (1.0 + m2.re), 0.5 * (1.0 - m2.re), 0.5 * m2.im);
     let det = cc * ss - cs * cs;
-    if !(det > 1e-12) {
+    if det.is_nan() || det <= 1e-12 {
         return Err(RtestError::Singular {
             at: whole(),
             detail: "the joint EIJ fit has no unique solution".into(),

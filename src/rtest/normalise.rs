@@ -350,7 +350,8 @@ fn steady_revolutions(
             .copied()
             .filter(|w| w.is_finite())
             .fold(f64::NEG_INFINITY, f64::max);
-        if !(top > 0.0) {
+        // `top` is the largest finite speed (or −∞ where there is none): never NaN.
+        if top <= 0.0 {
             return Err(too_short("no steady rotation found".into()));
         }
         let mut fast: Vec<f64> = speed.iter().copied().filter(|&w| w >= 0.5 * top).collect();

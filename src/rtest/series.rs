@@ -95,7 +95,7 @@ impl CircleSeries {
 
     /// Builds a series from columns already read from files (`lines`: the file line of every
     /// row, `names`: the files' names of the seven contract columns, where they differ).
-    pub fn from_parts(
+    pub(crate) fn from_parts(
         source: String,
         t_s: Vec<f64>,
         int_mm: [Vec<f64>; 3],
@@ -117,7 +117,7 @@ impl CircleSeries {
 
     /// The file's name of a contract column with the contract name, e.g. `Time (t_s)`, or
     /// the contract name where the file uses it.
-    pub fn column_label(&self, contract: &str) -> String {
+    pub(crate) fn column_label(&self, contract: &str) -> String {
         let file_name = self.names.as_ref().and_then(|names| {
             CONTRACT_COLUMNS
                 .iter()
@@ -181,7 +181,7 @@ impl CircleSeries {
     }
 
     /// Whether the series was read from a file (else built in memory).
-    pub fn is_from_file(&self) -> bool {
+    pub(crate) fn is_from_file(&self) -> bool {
         self.lines.is_some()
     }
 

@@ -3,6 +3,7 @@
 //! series with known EIJ ([`synth`]). Every test file uses it with `mod common;`.
 #![allow(dead_code)]
 
+pub mod bad_input;
 pub mod circle_terms;
 pub mod diagnosis_checks;
 pub mod diagnosis_demo;

@@ -7,7 +7,7 @@ use super::decompose::{
     InPlaneDesign, Solved,
 };
 use super::terms::{self, Combine, Family, Spec};
-use super::{CrossingValue, Curves, DiagnosisOptions, Figure, Source, SourceDiagnosis, Term};
+use super::{CrossingValue, Curves, DiagnosisOptions, Figure, Note, Source, SourceDiagnosis, Term};
 use crate::axes::Plane;
 
 /// A source's deviation over the steady revolutions, µm.
@@ -65,10 +65,9 @@ pub(super) fn fit_source(
             .map(|s| s.name.as_str())
             .filter(|n| !kept.contains(n))
             .collect();
-        notes.push(format!(
-            "not separable from the other terms in this test, left out: {}",
-            dropped.join(", ")
-        ));
+        notes.push(Note::LeftOut {
+            terms: dropped.into_iter().map(str::to_string).collect(),
+        });
     }
     let (n_cols, n_specs) = terms::normal(plane);
     let n_design = normal_design(&n_cols, circle, theta);
@@ -111,11 +110,7 @@ pub(super) fn fit_source(
     out_of_plane.sort_by(by_contribution);
     in_plane.extend(out_of_plane);
     if let Some(sq) = in_plane.iter_mut().find(|t| t.name == "squareness") {
-        sq.notes.push(
-            "the 45° ellipse of this test: squareness and servo mismatch together until a test \
-             in the opposite direction separates them"
-                .into(),
-        );
+        sq.notes.push(Note::SquarenessWithServo);
     }
     let zeros = vec![0.0; theta.len()];
     Some(SourceDiagnosis {

@@ -52,10 +52,12 @@ use crate::axes::{Axis, Direction, Plane};
 pub(crate) mod basis;
 pub(crate) mod decompose;
 mod fit;
+mod note;
 pub(crate) mod separate;
 pub(crate) mod terms;
 pub mod tolerance;
 
+pub use note::Note;
 pub use separate::{separate, GroupSeparation};
 
 /// Options of the diagnosis.
@@ -163,7 +165,7 @@ pub struct Term {
     pub crossings: Vec<CrossingValue>,
     /// What the value may also be, and what tests at other accelerations or directions said.
     #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub notes: Vec<String>,
+    pub notes: Vec<Note>,
     /// The tolerance on |value|, where `[tolerances]` gives one ([`tolerance::judge`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub limit: Option<f64>,
@@ -212,7 +214,7 @@ pub struct SourceDiagnosis {
     pub circular_deviation_terms_um: f64,
     /// Terms left out (a design without a unique solution) and the like.
     #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub notes: Vec<String>,
+    pub notes: Vec<Note>,
     /// The deviations behind the figures, for plots.
     #[serde(skip)]
     pub curves: Curves,
@@ -225,7 +227,7 @@ impl SourceDiagnosis {
     }
 
     /// Mutable access to the term called `name`.
-    pub fn term_mut(&mut self, name: &str) -> Option<&mut Term> {
+    pub(crate) fn term_mut(&mut self, name: &str) -> Option<&mut Term> {
         self.terms.iter_mut().find(|t| t.name == name)
     }
 }

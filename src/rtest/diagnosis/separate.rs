@@ -17,8 +17,8 @@
 
 use serde::Serialize;
 
-use super::terms::{MS, UM_PER_M};
-use super::{CircleDiagnosis, Figure, Source, Term};
+use super::terms::MS;
+use super::{CircleDiagnosis, Figure, Note, Source, Term};
 use crate::axes::Plane;
 use crate::rtest::lstsq::lstsq;
 
@@ -69,7 +69,7 @@ pub struct GroupSeparation {
     /// Per source (`internal`, `structure`, `tcp`), every term.
     pub sources: std::collections::BTreeMap<&'static str, Vec<TermSeparation>>,
     /// What the group could not separate.
-    pub notes: Vec<String>,
+    pub notes: Vec<Note>,
 }
 
 /// Groups `tests` by plane and circle centre, separates each group and writes the result into
@@ -122,17 +122,10 @@ fn separate_group(tests: &mut [CircleDiagnosis], idx: &[usize]) -> GroupSeparati
     };
     let mut notes = Vec::new();
     if !cond.several_accels {
-        notes.push(
-            "one acceleration: geometry and acceleration-correlated terms (EIJ) not separated"
-                .to_string(),
-        );
+        notes.push(Note::OneAcceleration);
     }
     if !cond.both_directions {
-        notes.push(
-            "one direction: squareness and servo mismatch not separated (the 45° ellipse is \
-             reported as squareness)"
-                .to_string(),
-        );
+        notes.push(Note::OneDirection);
     }
     let mut sources = std::collections::BTreeMap::new();
     for source in Source::ALL {
@@ -259,26 +252,16 @@ fn write_back(
     let Some(term) = sd.term_mut(&sep.name) else {
         return;
     };
-    let accels: Vec<String> = cond.accel.iter().map(|a| format!("{a:.2}")).collect();
-    let slope_note = |what: &str| {
-        sep.per_m_s2.map(|kappa| {
-            format!(
-                "grows with acceleration, {kappa:.4} ± {:.4} {} per m/s² over the tests at \
-                 {} m/s²: not geometry but {what}; the part at no acceleration is {:.3} ± {:.3}",
-                sep.per_m_s2_std_err.unwrap_or(f64::NAN),
-                sep.unit,
-                accels.join(", "),
-                sep.geometric,
-                sep.geometric_std_err
-            )
+    let slope_note = || {
+        sep.per_m_s2.map(|per_m_s2| Note::GrowsWithAcceleration {
+            per_m_s2,
+            per_m_s2_std_err: sep.per_m_s2_std_err.unwrap_or(f64::NAN),
+            unit: sep.unit,
+            accelerations_m_s2: cond.accel.clone(),
+            source,
+            geometric: sep.geometric,
+            geometric_std_err: sep.geometric_std_err,
         })
-    };
-    let what = match source {
-        Source::Internal => "a dynamic control error",
-        Source::Structure => "EIJ",
-        Source::Tcp => {
-            "EIJ or a dynamic control error (the internal and the structure source tell which)"
-        }
     };
     if let (Some(dtau), Some(dtau_se)) = (sep.servo_mismatch_ms, sep.servo_mismatch_std_err_ms) {
         let apparent = term.value;
@@ -287,11 +270,11 @@ fn write_back(
         term.value = sep.geometric + accel_part;
         term.std_err = sep.geometric_std_err;
         term.contribution_um = term.value.abs() * r_m;
-        term.notes = vec![format!(
-            "direction-independent part of the 45° ellipse over the tests in both directions \
-             (this test alone: {apparent:.3} {UM_PER_M}, of which {servo_part:.3} servo mismatch)"
-        )];
-        term.notes.extend(slope_note(what));
+        term.notes = vec![Note::DirectionIndependent {
+            apparent,
+            servo_part,
+        }];
+        term.notes.extend(slope_note());
         let servo = Term {
             name: "servo_mismatch".into(),
             value: dtau,
@@ -302,13 +285,11 @@ fn write_back(
             contribution_um: servo_part.abs() * r_m,
             figure: Figure::CircularDeviation,
             crossings: Vec::new(),
-            notes: vec![format!(
-                "lag of axis {} minus lag of axis {} (the 45° ellipse that flips with the \
-                 direction), at {:.0} mm/min",
-                test.plane.axes().0,
-                test.plane.axes().1,
-                test.feed_mm_min
-            )],
+            notes: vec![Note::ServoLag {
+                first: test.plane.axes().0,
+                second: test.plane.axes().1,
+                feed_mm_min: test.feed_mm_min,
+            }],
             limit: None,
             verdict: None,
         };
@@ -317,13 +298,9 @@ fn write_back(
         rerank(&mut sd.terms);
         return;
     }
-    term.notes.extend(slope_note(what));
+    term.notes.extend(slope_note());
     if !cond.several_accels && source == Source::Structure && eij_shaped(&sep.name) {
-        term.notes.push(
-            "could be EIJ (the structure's deviation under acceleration): tests at another \
-             acceleration tell"
-                .into(),
-        );
+        term.notes.push(Note::CouldBeEij);
     }
 }
 
