@@ -628,3 +628,49 @@ fn evaluate_move_nominal_measures_what_the_compensation_leaves() {
         &["noset-nominal.csv", "header", "x_set_mm", "nominal path"],
     );
 }
+
+/// The stroke widths of the move figure's data traces (polylines of 50 points or more: the
+/// legend's and the grid's lines have two), in drawing order.
+fn trace_widths(svg: &str) -> Vec<String> {
+    let doc = roxmltree::Document::parse(svg).unwrap();
+    doc.descendants()
+        .filter(|n| n.has_tag_name("polyline"))
+        .filter(|n| {
+            n.attribute("points")
+                .unwrap_or("")
+                .split_whitespace()
+                .count()
+                >= 50
+        })
+        .map(|n| n.attribute("stroke-width").unwrap_or("").to_string())
+        .collect()
+}
+
+#[test]
+fn where_the_move_plots_traces_coincide_the_top_one_is_drawn_thin_over_the_others() {
+    // Issue 29 item 3: after the move the set point, the scale reading and the deviations lie
+    // on one another; drawn alike (all 2 px, in order) they showed as alternating dashes of
+    // both colours. Each panel now draws its first curve (the set point, or the main trace)
+    // last and 1 px wide over the others at 3 px: per panel some 3s, then one 1.
+    let (s, _, table) = identified();
+    for (extra, panels) in [
+        (vec![], vec![2, 2, 2]),
+        (vec!["--compensation", table.as_str()], vec![2, 2, 4]),
+    ] {
+        let (csv, svg) = (s.s("thin.csv"), s.s("thin.svg"));
+        let mut args = extra.clone();
+        args.extend(["--plot", svg.as_str()]);
+        let r = z_move_run(&csv, "0,0,0", &args);
+        assert!(r.ok, "{}", r.stderr);
+        let widths = trace_widths(&std::fs::read_to_string(&svg).unwrap());
+        let expected: Vec<String> = panels
+            .iter()
+            .flat_map(|&n| {
+                std::iter::repeat_n("3", n - 1)
+                    .chain(["1"])
+                    .map(String::from)
+            })
+            .collect();
+        assert_eq!(widths, expected, "{extra:?}");
+    }
+}
