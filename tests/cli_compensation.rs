@@ -347,6 +347,66 @@ fn the_report_shows_the_compensated_move_and_move_against_circle_eij() {
         .filter(|t| t.contains("with compensation"))
         .count();
     assert_eq!(with, 1, "one move figure shows the compensated deviation");
+    // The compensated move's figure finds its plain run on the page and draws that run's
+    // TCP − nominal path as "without compensation" (what the table reduces), as
+    // `simulate move --compensation --plot` does; not the structural ext − int.
+    let comp_svg = svgs
+        .iter()
+        .find(|t| t.contains("with compensation"))
+        .unwrap();
+    assert!(
+        comp_svg.contains("dx without compensation (TCP − nominal path)")
+            && comp_svg.contains("dx with compensation (TCP − nominal path)"),
+        "{comp_svg}"
+    );
+    // The table gives the compensated move's EIJ against the nominal path beside ext − int:
+    // the plain move's EIJ minus the table's k at the move (hand, from the table file), up to
+    // the servo lag on the correction (3 % of E, as evaluate-move --nominal is checked).
+    assert!(html.contains("<th>with compensation (TCP − nominal path)</th>"));
+    let (machine, table) = (&identified().1, &identified().2);
+    let m = Machine::from_file(Path::new(machine)).unwrap();
+    let t = CompensationTable::read(Path::new(table), &m).unwrap();
+    let cells = |file: &str, eij: &str| -> Vec<String> {
+        let row = html
+            .lines()
+            .find(|l| l.starts_with(&format!("<tr><td>{file}</td><td>{eij}</td>")))
+            .unwrap_or_else(|| panic!("no row {file} {eij}"));
+        row.trim_start_matches("<tr><td>")
+            .trim_end_matches("</td></tr>")
+            .split("</td><td>")
+            .map(String::from)
+            .collect()
+    };
+    for i in [Axis::X, Axis::Y] {
+        let e = Eij::new(i, Axis::Z);
+        let name = e.name();
+        let p = cells(&plain, &name);
+        let c = cells(&comp, &name);
+        assert_eq!((p[4].as_str(), p[5].as_str()), ("–", "–"), "{p:?}");
+        let e_plain: f64 = p[2].parse().unwrap();
+        let left: f64 = c[4].parse().unwrap();
+        let k = t.get(e).unwrap().at([0.0, 0.0, 10.0]);
+        assert!(
+            (left - (e_plain - k)).abs() < 0.03 * e_plain.abs(),
+            "{name}: with compensation {left}, E − k = {e_plain} − {k}"
+        );
+        // ext − int of the compensated move: the structure, which the table leaves but for
+        // what the correction's own small motions of X and Y excite (1 % on EYZ).
+        let e_comp: f64 = c[2].parse().unwrap();
+        assert!(
+            (e_comp - e_plain).abs() < 0.02 * e_plain.abs(),
+            "{c:?} {p:?}"
+        );
+    }
+    // The compensated move alone: no plain run to pair with, so the structural deviation
+    // stands for the move without the table, and says so.
+    let out = s.s("report-comp-alone");
+    let r = run(&["report", "--move", &comp, "--out", &out]);
+    assert!(r.ok, "{}", r.stderr);
+    let html = std::fs::read_to_string(Path::new(&out).join("report.html")).unwrap();
+    assert!(html.contains("dx ≈ without compensation (x_ext − x_int)"));
+    assert!(html.contains("dx with compensation (TCP − nominal path)"));
+    assert!(!html.contains("dx without compensation (TCP − nominal path)"));
 }
 
 /// The numbers of `text` (a header line or a console line) in order, as written.
@@ -567,4 +627,50 @@ fn evaluate_move_nominal_measures_what_the_compensation_leaves() {
         &common::eij(&["evaluate-move", &p, "--axis", "z", "--nominal"]),
         &["noset-nominal.csv", "header", "x_set_mm", "nominal path"],
     );
+}
+
+/// The stroke widths of the move figure's data traces (polylines of 50 points or more: the
+/// legend's and the grid's lines have two), in drawing order.
+fn trace_widths(svg: &str) -> Vec<String> {
+    let doc = roxmltree::Document::parse(svg).unwrap();
+    doc.descendants()
+        .filter(|n| n.has_tag_name("polyline"))
+        .filter(|n| {
+            n.attribute("points")
+                .unwrap_or("")
+                .split_whitespace()
+                .count()
+                >= 50
+        })
+        .map(|n| n.attribute("stroke-width").unwrap_or("").to_string())
+        .collect()
+}
+
+#[test]
+fn where_the_move_plots_traces_coincide_the_top_one_is_drawn_thin_over_the_others() {
+    // Issue 29 item 3: after the move the set point, the scale reading and the deviations lie
+    // on one another; drawn alike (all 2 px, in order) they showed as alternating dashes of
+    // both colours. Each panel now draws its first curve (the set point, or the main trace)
+    // last and 1 px wide over the others at 3 px: per panel some 3s, then one 1.
+    let (s, _, table) = identified();
+    for (extra, panels) in [
+        (vec![], vec![2, 2, 2]),
+        (vec!["--compensation", table.as_str()], vec![2, 2, 4]),
+    ] {
+        let (csv, svg) = (s.s("thin.csv"), s.s("thin.svg"));
+        let mut args = extra.clone();
+        args.extend(["--plot", svg.as_str()]);
+        let r = z_move_run(&csv, "0,0,0", &args);
+        assert!(r.ok, "{}", r.stderr);
+        let widths = trace_widths(&std::fs::read_to_string(&svg).unwrap());
+        let expected: Vec<String> = panels
+            .iter()
+            .flat_map(|&n| {
+                std::iter::repeat_n("3", n - 1)
+                    .chain(["1"])
+                    .map(String::from)
+            })
+            .collect();
+        assert_eq!(widths, expected, "{extra:?}");
+    }
 }

@@ -77,12 +77,13 @@ fn print_verdict(p: &Problem, result: &IdentResult, report: &IdentReport, second
         let rel = standing
             .rel_std_err()
             .map_or("-".to_string(), |r| format!("{:.1} %", 100.0 * r));
-        let plausible =
-            if standing != Standing::NotIdentifiable && implausible(&q.name, q.identified) {
-                ", implausible factor"
-            } else {
-                ""
-            };
+        let plausible = if standing != Standing::NotIdentifiable
+            && implausible(&q.name, q.identified, q.std_err)
+        {
+            ", implausible factor"
+        } else {
+            ""
+        };
         let interval = q.interval().map_or("-".to_string(), format_interval);
         match q.std_err {
             Some(s) => outln!(

@@ -43,17 +43,22 @@ pub fn run(args: ModalArgs) -> anyhow::Result<()> {
         outln!("{out}");
         return Ok(());
     }
-    outln!(
-        "Undamped modes of {} at {} (rigid-body modes of the drives at 0 Hz)",
-        machine.name(),
-        machine
-            .axes()
-            .iter()
-            .zip(&pose)
-            .map(|(a, p)| format!("{}={:.1} mm", a.axis, p * 1e3))
-            .collect::<Vec<_>>()
-            .join(", ")
-    );
+    // A machine without axes (a body on its supports) has no pose and no drives.
+    if machine.axes().is_empty() {
+        outln!("Undamped modes of {} (no axes)", machine.name());
+    } else {
+        outln!(
+            "Undamped modes of {} at {} (rigid-body modes of the drives at 0 Hz)",
+            machine.name(),
+            machine
+                .axes()
+                .iter()
+                .zip(&pose)
+                .map(|(a, p)| format!("{}={:.1} mm", a.axis, p * 1e3))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
     outln!(
         "{:>4}  {:>10}  {:<14} {:>6}",
         "mode",

@@ -111,7 +111,7 @@ pub(super) fn refusal(
 
 /// Warnings on identified factors: on a bound, or implausible ([`Implausible`]: a reduction
 /// factor stiffer than the catalogue or more than ten times softer, an elastic body's stiffness
-/// factor far from its FE model).
+/// factor far from its FE model, each beyond its uncertainty).
 pub(super) fn plausibility(parameters: &[Identified], settings: &Settings) -> Vec<Warning> {
     let (lo, hi) = (settings.min_factor, settings.max_factor);
     parameters
@@ -126,9 +126,10 @@ pub(super) fn plausibility(parameters: &[Identified], settings: &Settings) -> Ve
                     max: hi,
                 })
             } else {
-                Implausible::of(&q.name, q.value).map(|why| Warning::Implausible {
+                Implausible::of(&q.name, q.value, q.std_err).map(|why| Warning::Implausible {
                     name: q.name.clone(),
                     value: q.value,
+                    std_err: q.std_err,
                     why,
                 })
             }

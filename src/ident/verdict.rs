@@ -19,7 +19,7 @@
 //! scaled by s, do not cover that model error).
 
 use super::settings::{
-    BODY_PLAUSIBLE_MAX, BODY_PLAUSIBLE_MIN, CHI2_SIGMAS, DETERMINED_REL_STD_ERR,
+    BODY_PLAUSIBLE_MAX, BODY_PLAUSIBLE_MIN, CHI2_SIGMAS, DETERMINED_REL_STD_ERR, INTERVAL_SIGMAS,
     NOT_IDENTIFIABLE_REL_STD_ERR, PLAUSIBLE_MAX, PLAUSIBLE_MIN, WEAK_REL_STD_ERR,
 };
 
@@ -122,7 +122,11 @@ impl Standing {
 /// Why an identified factor is implausible. A reduction factor on catalogue data
 /// (`<axis>.guideway…`, `<axis>.screw`) is plausible in [[`PLAUSIBLE_MIN`], [`PLAUSIBLE_MAX`]];
 /// an elastic body's stiffness factor (`<body>.stiffness`) in [[`BODY_PLAUSIBLE_MIN`],
-/// [`BODY_PLAUSIBLE_MAX`]] around its FE model.
+/// [`BODY_PLAUSIBLE_MAX`]] around its FE model. A factor is implausible only when its whole
+/// [`INTERVAL_SIGMAS`] (3σ) interval ([`factor_interval`], taken in 1/p) lies outside that range:
+/// far from it beyond its uncertainty. A factor of 1.0003 ± 0.0010 (interval [0.9973, 1.0033])
+/// may well be 1 and is no alarm; 1.0300 ± 0.0010 ([1.0211, 1.0392]) is stiffer than the
+/// catalogue beyond doubt.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Implausible {
     /// A reduction factor above [`PLAUSIBLE_MAX`]: stiffer than the catalogue.
@@ -136,20 +140,26 @@ pub enum Implausible {
 }
 
 impl Implausible {
-    /// Whether the factor `value` of parameter `name` is implausible, and why; the kind of
-    /// factor follows from the name (`<body>.stiffness` is an elastic body's).
-    pub fn of(name: &str, value: f64) -> Option<Implausible> {
+    /// Whether the factor `value` ± `std_err` of parameter `name` is implausible, and why: its
+    /// [`INTERVAL_SIGMAS`] interval lies wholly above or below the plausible range (without
+    /// a standard error, the value alone is judged). The kind of factor follows from the name
+    /// (`<body>.stiffness` is an elastic body's).
+    pub fn of(name: &str, value: f64, std_err: Option<f64>) -> Option<Implausible> {
+        let (low, high) = factor_interval(value, std_err.unwrap_or(0.0), INTERVAL_SIGMAS)
+            .unwrap_or((value, Some(value)));
+        let above = |limit: f64| low > limit;
+        let below = |limit: f64| high.is_some_and(|h| h < limit);
         if name.ends_with(".stiffness") {
-            if value < BODY_PLAUSIBLE_MIN {
+            if below(BODY_PLAUSIBLE_MIN) {
                 Some(Implausible::SofterThanFeModel)
-            } else if value > BODY_PLAUSIBLE_MAX {
+            } else if above(BODY_PLAUSIBLE_MAX) {
                 Some(Implausible::StifferThanFeModel)
             } else {
                 None
             }
-        } else if value > PLAUSIBLE_MAX {
+        } else if above(PLAUSIBLE_MAX) {
             Some(Implausible::StifferThanCatalogue)
-        } else if value < PLAUSIBLE_MIN {
+        } else if below(PLAUSIBLE_MIN) {
             Some(Implausible::FarSofterThanCatalogue)
         } else {
             None
@@ -170,28 +180,35 @@ impl Implausible {
         }
     }
 
-    /// The warning for parameter `name` identified as `value`.
-    pub fn warning(self, name: &str, value: f64) -> String {
+    /// The warning for parameter `name` identified as `value` ± `std_err`.
+    pub fn warning(self, name: &str, value: f64, std_err: Option<f64>) -> String {
+        let at = match std_err.and_then(|s| {
+            factor_interval(value, s, INTERVAL_SIGMAS).map(|i| (s, format_interval(i)))
+        }) {
+            Some((s, interval)) => format!("{name} = {value:.4} ± {s:.4} (3σ interval {interval})"),
+            None => format!("{name} = {value:.4}"),
+        };
         match self {
             Implausible::StifferThanCatalogue => format!(
-                "{name} = {value:.4} > {PLAUSIBLE_MAX}: stiffer than its catalogue data, implausible for a reduction factor (a compliance missing elsewhere in the model, or a data problem)"
+                "{at} lies above {PLAUSIBLE_MAX} beyond its uncertainty: stiffer than its catalogue data, implausible for a reduction factor (a compliance missing elsewhere in the model, or a data problem)"
             ),
             Implausible::FarSofterThanCatalogue => format!(
-                "{name} = {value:.4} < {PLAUSIBLE_MIN}: more than ten times softer than its catalogue data, implausible (a compliance missing elsewhere in the model, or a data problem)"
+                "{at} lies below {PLAUSIBLE_MIN} beyond its uncertainty: more than ten times softer than its catalogue data, implausible (a compliance missing elsewhere in the model, or a data problem)"
             ),
             Implausible::SofterThanFeModel => format!(
-                "{name} = {value:.4} < {BODY_PLAUSIBLE_MIN}: the body is more than twice as soft as its FE model, far beyond what its material allows: the FE model (sections, mesh, material) or the joints that hold the body (bolted flanges, feet, attachments) are likely wrong, or a compliance is missing elsewhere in the model"
+                "{at} lies below {BODY_PLAUSIBLE_MIN} beyond its uncertainty: the body is more than twice as soft as its FE model, far beyond what its material allows: the FE model (sections, mesh, material) or the joints that hold the body (bolted flanges, feet, attachments) are likely wrong, or a compliance is missing elsewhere in the model"
             ),
             Implausible::StifferThanFeModel => format!(
-                "{name} = {value:.4} > {BODY_PLAUSIBLE_MAX}: the body is more than twice as stiff as its FE model, far beyond what its material allows: the FE model (sections, mesh, material) or the joints that hold the body are likely wrong, or the other compliances of the model are too large"
+                "{at} lies above {BODY_PLAUSIBLE_MAX} beyond its uncertainty: the body is more than twice as stiff as its FE model, far beyond what its material allows: the FE model (sections, mesh, material) or the joints that hold the body are likely wrong, or the other compliances of the model are too large"
             ),
         }
     }
 }
 
-/// Whether the identified factor `value` of parameter `name` is implausible ([`Implausible`]).
-pub fn implausible(name: &str, value: f64) -> bool {
-    Implausible::of(name, value).is_some()
+/// Whether the identified factor `value` ± `std_err` of parameter `name` is implausible
+/// ([`Implausible::of`]).
+pub fn implausible(name: &str, value: f64, std_err: Option<f64>) -> bool {
+    Implausible::of(name, value, std_err).is_some()
 }
 
 /// The interval p ∈ [low, high] of a factor identified as `value` ± `std_err`, `k` standard

@@ -65,6 +65,8 @@ pub enum Warning {
         name: String,
         /// Its factor.
         value: f64,
+        /// Its standard error.
+        std_err: Option<f64>,
         /// Which way it is implausible.
         why: Implausible,
     },
@@ -117,7 +119,12 @@ impl fmt::Display for Warning {
                 f,
                 "{name} = {value} ended on a bound of the factors [{min}, {max}]: the data want a value outside"
             ),
-            Warning::Implausible { name, value, why } => f.write_str(&why.warning(name, *value)),
+            Warning::Implausible {
+                name,
+                value,
+                std_err,
+                why,
+            } => f.write_str(&why.warning(name, *value, *std_err)),
             Warning::ModelMismatch(m) => f.write_str(&m.warning()),
             Warning::TimeDomainDisagrees {
                 test,

@@ -185,6 +185,7 @@ pub fn generate(req: &ReportRequest) -> Result<PathBuf, ReportError> {
             ))
         })
         .collect::<Result<Vec<_>, ReportError>>()?;
+    let moves = with_plain_runs(moves)?;
 
     let history = if req.history.is_empty() {
         None
@@ -447,36 +448,83 @@ fn tolerance_verdict_html(d: &SuiteDiagnosis, suite: &Suite) -> String {
     h
 }
 
+/// A compensated move whose plain run (the same move without the table, [`MoveData::
+/// same_nominal_move`]) is on the page draws that run's TCP − nominal path as "without
+/// compensation", as `eij simulate move --compensation --plot` does, instead of the structural
+/// deviation that stands in for it.
+fn with_plain_runs(moves: Vec<(MoveData, Figure)>) -> Result<Vec<(MoveData, Figure)>, ReportError> {
+    let plain: Vec<MoveData> = moves.iter().map(|(d, _)| d.clone()).collect();
+    moves
+        .into_iter()
+        .map(|(mut data, mut figure)| {
+            if let Some(p) = plain.iter().find(|p| data.same_nominal_move(p)) {
+                data.uncompensated_um = p.path_deviation_um.clone();
+                figure.svg = move_svg(
+                    &data,
+                    &Conditions {
+                        source: data.source.clone(),
+                        ..Default::default()
+                    },
+                )?;
+            }
+            Ok((data, figure))
+        })
+        .collect()
+}
+
 /// EIJ of each move (`eij evaluate-move`) beside the mean of the circle tests that accelerate
-/// the same axis.
+/// the same axis: the structure's (external − internal) and, for a move with a compensation
+/// (`<b>_comp_mm` columns), what the compensation leaves (external − nominal path, as
+/// `eij evaluate-move --nominal` fits it).
 fn move_vs_circle_html(
     h: &mut String,
     paths: &[PathBuf],
     moves: &[(MoveData, Figure)],
     circles: &[EvaluatedTest],
 ) {
+    use crate::measured::moves::{evaluate_move_against, Reference};
+    let compensated = moves.iter().any(|(d, _)| d.is_compensated());
     let _ = writeln!(
         h,
         "<h3 id=\"{}\">EIJ from the moves and from the circles</h3>\n<p class=\"note\">Move: external − \
          internal against the set acceleration over the whole move (with velocity, constant and \
-         position terms; docs/compensation.md). Circles: mean over the circle tests above whose \
+         position terms; docs/compensation.md){}. Circles: mean over the circle tests above whose \
          plane holds the moved axis. A move's acceleration spreads over 0–30 Hz, a circle's is \
          one line near 8 Hz: they agree where the structure responds alike over that band.</p>",
-        anchor("move-vs-circle")
+        anchor("move-vs-circle"),
+        if compensated {
+            "; for a move with a compensation table also external − nominal path, the TCP's \
+             deviation from the path asked for: what the compensation leaves of the structure's \
+             EIJ (external − internal, which a compensation of the set points does not change). \
+             Against the nominal path the moved axis's own E<sub>JJ</sub> holds its following \
+             error too: read the cross-talk rows"
+        } else {
+            ""
+        }
     );
     let _ = writeln!(
         h,
-        "<table>\n<tr><th>move</th><th>EIJ</th><th>move</th><th>± std err</th><th>circles (n)</th></tr>"
+        "<table>\n<tr><th>move</th><th>EIJ</th><th>move (ext − int)</th><th>± std err</th>{}<th>circles (n)</th></tr>",
+        if compensated {
+            "<th>with compensation (TCP − nominal path)</th><th>± std err</th>"
+        } else {
+            ""
+        }
     );
     for (path, (data, _)) in paths.iter().zip(moves) {
-        let Ok(m) = crate::measured::moves::evaluate_move(path, data.axis) else {
+        let name = escape(&path.display().to_string());
+        let Ok(m) = evaluate_move_against(path, data.axis, Reference::Internal) else {
             let _ = writeln!(
                 h,
-                "<tr><td>{}</td><td colspan=\"4\">no set acceleration to evaluate</td></tr>",
-                escape(&path.display().to_string())
+                "<tr><td>{name}</td><td colspan=\"{}\">no set acceleration to evaluate</td></tr>",
+                if compensated { 6 } else { 4 }
             );
             continue;
         };
+        let nominal = data
+            .is_compensated()
+            .then(|| evaluate_move_against(path, data.axis, Reference::Nominal).ok())
+            .flatten();
         for (e, v) in &m.eij {
             let vals: Vec<f64> = circles
                 .iter()
@@ -491,10 +539,21 @@ fn move_vs_circle_html(
                     vals.len()
                 )
             };
+            let with = match (&nominal, compensated) {
+                (_, false) => String::new(),
+                (Some(n), true) => match n.eij.get(e) {
+                    Some(w) => format!(
+                        "<td>{}</td><td>{}</td>",
+                        fmt_eij(w.value),
+                        fmt_eij(w.std_err)
+                    ),
+                    None => "<td>–</td><td>–</td>".into(),
+                },
+                (None, true) => "<td>–</td><td>–</td>".into(),
+            };
             let _ = writeln!(
                 h,
-                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
-                escape(&path.display().to_string()),
+                "<tr><td>{name}</td><td>{}</td><td>{}</td><td>{}</td>{with}<td>{}</td></tr>",
                 e.name(),
                 fmt_eij(v.value),
                 fmt_eij(v.std_err),

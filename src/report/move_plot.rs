@@ -38,6 +38,11 @@ pub struct MoveData {
     /// For a compensated move (`<b>_comp_mm` columns), the TCP's deviation from the nominal
     /// path ext − set of the other axes, µm: what remains with the compensation.
     pub compensated_um: Vec<(Axis, Vec<f64>)>,
+    /// The TCP's deviation from the path in the file's set columns, ext − set of the other
+    /// axes, µm, for any move file that has them (a compensated one: its nominal path): how a
+    /// compensated move on the same page finds the same move run without the table
+    /// ([`MoveData::same_nominal_move`]).
+    pub path_deviation_um: Vec<(Axis, Vec<f64>)>,
     /// The planned profile of the move, when known ([`MoveData::planned`]): the header then
     /// states its peak velocity, acceleration and jerk (the numbers `eij simulate move`
     /// prints) instead of estimates from the samples.
@@ -125,11 +130,10 @@ impl MoveData {
                 ))
             })
             .collect();
-        let compensated_um = Axis::ALL
+        let path_deviation_um: Vec<(Axis, Vec<f64>)> = Axis::ALL
             .into_iter()
             .filter(|&b| b != axis)
             .filter_map(|b| {
-                column(&format!("{b}_comp_mm"))?;
                 let set = column(&format!("{b}_set_mm"))?;
                 let ext = column(&format!("{b}_ext_mm"))?;
                 Some((
@@ -138,9 +142,15 @@ impl MoveData {
                 ))
             })
             .collect();
+        let compensated_um = path_deviation_um
+            .iter()
+            .filter(|(b, _)| find(&format!("{b}_comp_mm")).is_some())
+            .cloned()
+            .collect();
         Ok(MoveData {
             axis,
             compensated_um,
+            path_deviation_um,
             plan: None,
             uncompensated_um: Vec::new(),
             set_mm: need("set_mm")?,
@@ -190,6 +200,7 @@ impl MoveData {
             acc_act_m_s2: get(format!("{axis}_acc_act_m_s2"), false, 1.0)?,
             cross_talk_um,
             compensated_um: Vec::new(),
+            path_deviation_um: Vec::new(),
             plan: None,
             uncompensated_um: Vec::new(),
             source,
@@ -248,6 +259,32 @@ impl MoveData {
             })
             .collect();
         Ok(self)
+    }
+
+    /// Whether the move ran with a compensation table: it has the TCP's deviation from the
+    /// nominal path ([`MoveData::compensated_um`]).
+    pub fn is_compensated(&self) -> bool {
+        !self.compensated_um.is_empty()
+    }
+
+    /// Whether `plain`, a move without compensation, is this compensated move run without
+    /// its table: the same moved axis, the same instants and the same nominal path of every
+    /// axis (set columns equal to 1 nm).
+    pub fn same_nominal_move(&self, plain: &MoveData) -> bool {
+        let close = |a: &[f64], b: &[f64]| {
+            a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x - y).abs() <= 1e-6)
+        };
+        self.is_compensated()
+            && !plain.is_compensated()
+            && plain.axis == self.axis
+            && close(&plain.t_s, &self.t_s)
+            && close(&plain.set_mm, &self.set_mm)
+            && plain.path_deviation_um.len() == self.compensated_um.len()
+            && plain
+                .path_deviation_um
+                .iter()
+                .zip(&self.compensated_um)
+                .all(|((a, _), (b, _))| a == b)
     }
 
     /// Signed distance of the set position, mm.
@@ -357,7 +394,7 @@ pub fn move_svg(data: &MoveData, cond: &Conditions) -> Result<String, ReportErro
                 } else if data.compensated_um.is_empty() {
                     format!("d{b} = {b}_ext − {b}_int")
                 } else {
-                    format!("d{b} without compensation ({b}_ext − {b}_int)")
+                    format!("d{b} ≈ without compensation ({b}_ext − {b}_int)")
                 };
                 (label, c, series(v))
             })
@@ -389,9 +426,13 @@ pub fn move_svg(data: &MoveData, cond: &Conditions) -> Result<String, ReportErro
             } else {
                 vec![
                     format!("cross-talk while {ax} moves:"),
-                    format!("structural (= uncompensated)"),
-                    format!("and TCP − nominal path with"),
-                    format!("the compensation table"),
+                    format!("TCP − nominal path with the"),
+                    format!("compensation table; the"),
+                    format!("structure's ext − int, which"),
+                    format!("it does not change, stands"),
+                    format!("for the move without it (the"),
+                    format!("plain move's file on the same"),
+                    format!("page replaces it exactly)"),
                 ]
             },
         ),

@@ -66,12 +66,13 @@ impl PolarScale {
         }
     }
 
-    /// What the rings mean, for a figure's header: `rings every 2 µm from −4 µm (inner) to
-    /// +4 µm (outer) · bold ring: the set circle (0)`.
+    /// What the rings mean, for a figure's header: `rings every 2 µm from -4 µm (inner) to
+    /// +4 µm (outer) · bold ring: the set circle (0)`; numbers with the ASCII minus, as every
+    /// number eij prints on the console and the page.
     pub(crate) fn rings_key(&self) -> String {
         let outer = self.ring_um * self.rings as f64;
         format!(
-            "rings every {} µm from −{} µm (inner) to +{} µm (outer) · bold ring: the set circle (0)",
+            "rings every {} µm from -{} µm (inner) to +{} µm (outer) · bold ring: the set circle (0)",
             short(self.ring_um, 3),
             short(outer, 3),
             short(outer, 3)
@@ -268,8 +269,8 @@ fn polar_panel(
     for (text, x, y) in [
         (format!("+{a}"), out, 0.0),
         (format!("+{b}"), -0.05, out + 0.08),
-        (format!("−{a}"), -out - 0.17, 0.0),
-        (format!("−{b}"), -0.05, -out - 0.02),
+        (format!("-{a}"), -out - 0.17, 0.0),
+        (format!("-{b}"), -0.05, -out - 0.02),
     ] {
         chart.draw_series(std::iter::once(Text::new(
             text,

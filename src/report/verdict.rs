@@ -192,7 +192,7 @@ pub(crate) fn parameters_html(r: &IdentReport) -> String {
                 remark.push(format!("bounds [{}, {}]", short(lo, 4), short(hi, 4)));
             }
         }
-        if let Some(why) = Implausible::of(&p.name, p.identified) {
+        if let Some(why) = Implausible::of(&p.name, p.identified, p.std_err) {
             if s != Standing::NotIdentifiable {
                 remark.push(format!("implausible: {}", why.remark()));
             }
