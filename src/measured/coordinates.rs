@@ -177,10 +177,11 @@ mod tests {
         let mut int = xy_circle([150.0, -100.0]);
         place(&how, "xy.sco", &mut int, [false, false, true]).unwrap();
         // x, y relative to the centre: a circle of radius 2 about 0; z untouched (not +200).
-        for k in 0..100 {
-            let r = int[0][k].hypot(int[1][k]);
+        assert!(int.iter().all(|a| a.len() == 100));
+        for ((x, y), z) in int[0].iter().zip(&int[1]).zip(&int[2]).take(100) {
+            let r = x.hypot(*y);
             assert!((r - 2.0).abs() < 1e-12, "radius {r}");
-            assert_eq!(int[2][k], 0.0);
+            assert_eq!(*z, 0.0);
         }
         // Without the absent mark the same readings lie 200 mm from the centre in z: refused.
         let mut int = xy_circle([150.0, -100.0]);
