@@ -21,7 +21,7 @@ use super::{assemble, text_of, Channel, Found};
 use crate::axes::{Axis, Plane};
 use crate::io::delimited::{parse_number, quote_cell};
 use crate::measured::error::MeasuredError;
-use crate::measured::layout::{parse_decimal, ColumnMap};
+use crate::measured::layout::{parse_decimal, ColumnMap, Unit};
 use crate::rtest::clock::Recording;
 use crate::rtest::series::INT_COLUMNS;
 use crate::rtest::Location;
@@ -72,13 +72,15 @@ enum Section {
     Other,
 }
 
-/// Millimetres per unit of a `%DIMENSION=` of positions.
+/// Millimetres per unit of a `%DIMENSION=` of positions: mm and µm as [`Unit`] reads them, and
+/// inch.
 fn mm_per(dimension: &str) -> Option<f64> {
-    match dimension.trim().to_lowercase().as_str() {
-        "mm" => Some(1.0),
-        "µm" | "μm" | "um" => Some(1e-3),
+    let d = dimension.trim().to_lowercase();
+    match d.as_str() {
         "inch" | "in" | "\"" => Some(25.4),
-        _ => None,
+        _ => Unit::parse(&d)
+            .filter(|u| matches!(u, Unit::Mm | Unit::Um))
+            .map(Unit::to_contract),
     }
 }
 
